@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# One entry point for the project.
+#
+#   ./build.sh          set up, build the FMUs, build the report
+#   ./build.sh setup    system packages (Debian) + .venv with pinned Python packages
+#   ./build.sh fmu      build/LCV.fmu (pythonfmu) and build/LCVNative.fmu (C)
+#   ./build.sh report   execute the notebooks, write build/report/{index.html,report.pdf,data/}
+#   ./build.sh test     set up, build the FMUs, run the whole test suite
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+cd "$ROOT"
+VENV="$ROOT/.venv"
+PY="$VENV/bin/python"
+export PYTHONHASHSEED=0
+export SOURCE_DATE_EPOCH=1312156800   # 2011-08-01, the dissertation's date: reproducible PDFs
+
+# Debian packages: LaTeX route of nbconvert (PDF), MathJax for the offline HTML,
+# TBB for ecos, poppler for PDF checks, valgrind and gcc for the native FMU.
+APT_PACKAGES=(texlive-xetex texlive-fonts-recommended texlive-plain-generic pandoc libjs-mathjax
+              fonts-dejavu-core libtbb12 poppler-utils valgrind gcc)
+
+log() { printf '[build.sh] %s\n' "$*" >&2; }
+
+system_packages() {
+    local missing=() p
+    for p in "${APT_PACKAGES[@]}"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+    done
+    [ ${#missing[@]} -eq 0 ] && return 0
+    local sudo=""
+    if [ "$(id -u)" != 0 ]; then
+        command -v sudo >/dev/null || { log "need root to install Debian packages: ${missing[*]}"; exit 1; }
+        sudo="sudo"
+    fi
+    log "installing Debian packages: ${missing[*]}"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+python_env() {
+    [ -x "$PY" ] || { log "creating .venv"; python3 -m venv "$VENV"; }
+    local stamp
+    stamp="$VENV/.installed-$(cat pyproject.toml constraints.txt | sha1sum | cut -c1-16)"
+    if [ ! -f "$stamp" ]; then
+        log "installing the package and pinned dependencies into .venv"
+        "$PY" -m pip install -q -c constraints.txt -e ".[fmu,report,test]"
+        rm -f "$VENV"/.installed-*
+        touch "$stamp"
+    fi
+}
+
+setup() { system_packages; python_env; }
+
+fmu() {
+    mkdir -p build
+    if [ -f lcvreport/fmu_build.py ]; then "$PY" -m lcvreport.fmu_build --out build; else log "no FMU yet"; fi
+}
+
+report() {
+    if [ -f lcvreport/report.py ]; then "$PY" -m lcvreport.report --build-dir build; else log "no report yet"; fi
+}
+
+run_tests() {
+    "$PY" -m pytest -q -n 2 -p no:cacheprovider "$@"
+}
+
+cmd="${1:-all}"
+[ $# -gt 0 ] && shift
+case "$cmd" in
+    all)    setup; fmu; report ;;
+    setup)  setup ;;
+    fmu)    setup; fmu ;;
+    report) setup; report ;;
+    test)   setup; fmu; run_tests "$@" ;;
+    *)      echo "usage: ./build.sh [all|setup|fmu|report|test]" >&2; exit 2 ;;
+esac
