@@ -53,7 +53,7 @@ setup() { system_packages; python_env; }
 
 fmu() {
     mkdir -p build
-    if [ -f lcvreport/fmu_build.py ]; then "$PY" -m lcvreport.fmu_build --out build; else log "no FMU yet"; fi
+    "$PY" -m lcvreport.fmu_build --out build
 }
 
 report() {
