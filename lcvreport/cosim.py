@@ -94,6 +94,46 @@ def validate_parameters(preset: str, tire_scale: float, u_min: float) -> None:
         raise CosimError("u_min", f"u_min must be finite and > 0 [m/s], got {u_min!r}")
 
 
+def input_matrix_si(train, tire_scale: float = 1.0) -> np.ndarray:
+    """Generalized force (thesis units) per SI input, columns in :data:`INPUT_NAMES`
+    order: u (a zero column: speed enters through the matrices), delta [rad],
+    P [N] x8, T [N.m] x8 (zero columns for axles the train lacks)."""
+    co = system_coefficients(train)
+    B = np.zeros((co.n_states, len(INPUT_NAMES)))
+    B[:, 1] = co.B_delta(tire_scale)
+    names = train.axle_names
+    for j, a in enumerate(FMU_AXLES):
+        if a in names:
+            col = names.index(a)
+            B[:, 2 + j] = co.B_P[:, col] / N_PER_LBF
+            B[:, 2 + len(FMU_AXLES) + j] = co.B_T[:, col] / NM_PER_LBF_IN
+    return B
+
+
+def output_matrix(train) -> np.ndarray:
+    """Map from ``z = [x, psi1, Y1]`` (thesis units) to the outputs that are linear in z,
+    in :data:`OUTPUT_NAMES` order and SI (rows of y2..y6 and max_real_eig are zero),
+    followed by the headings of units 2..N relative to the tractor
+    (thetaA + ... + theta_k) [rad] that eq. 4.42-4.46 take the sine of."""
+    n_u = train.n_units
+    n = 2 * n_u
+    n_out = len(OUTPUT_NAMES)
+    C = np.zeros((n_out + n_u - 1, n + 2))
+    C[0, 0] = M_PER_IN                                   # v1
+    for i in range(n_u):
+        C[1 + i, 1 + i] = 1.0                            # r_i
+    for k in range(n_u - 1):
+        C[7 + k, 1 + n_u + k] = 1.0                      # theta
+        C[n_out + k, 1 + n_u:2 + n_u + k] = 1.0          # thetaA + ... + theta_k
+    C[17, n] = 1.0                                       # psi1
+    C[18, n + 1] = M_PER_IN                              # Y1
+    for j in range(n + 2):                               # Y_rear is linear: apply it to unit vectors
+        e = np.zeros(n + 2)
+        e[j] = 1.0
+        C[19, j] = float(rear_end_global(train, e[n], e[n + 1], e[1 + n_u:n])) * M_PER_IN
+    return C
+
+
 class LCVEngine:
     """Exact zero-order-hold stepping of one vehicle, SI interface.
 
@@ -128,45 +168,14 @@ class LCVEngine:
         self._eig_cache: dict = {}
         self._cache_size = cache_size
         self._B_si = self._input_matrix_si()
-        self._C = self._output_matrix()
+        self._C = output_matrix(self.train)
         self._L_m = (unit_lengths(self.train) * M_PER_IN).tolist()
         self.reset()
 
     # ------------------------------------------------------------------ set-up
     def _input_matrix_si(self) -> np.ndarray:
-        """Generalized force (thesis units) per SI input, columns in :data:`INPUT_NAMES`
-        order: u (zero column: speed enters through the matrices), delta [rad],
-        P [N] x8, T [N.m] x8."""
-        co = self._co
-        B = np.zeros((self.n, len(INPUT_NAMES)))
-        B[:, 1] = co.B_delta(self.tire_scale)
-        names = self.train.axle_names
-        for j, a in enumerate(FMU_AXLES):
-            if a in names:
-                col = names.index(a)
-                B[:, 2 + j] = co.B_P[:, col] / N_PER_LBF
-                B[:, 2 + len(FMU_AXLES) + j] = co.B_T[:, col] / NM_PER_LBF_IN
-        return B
-
-    def _output_matrix(self) -> np.ndarray:
-        """Rows: the outputs that are linear in z, in :data:`OUTPUT_NAMES` order (SI),
-        then the headings of units 2..N relative to the tractor (thetaA + ... ) [rad]."""
-        n_u, n = self.n_units, self.n
-        n_out = len(OUTPUT_NAMES)
-        C = np.zeros((n_out + n_u - 1, n + 2))
-        C[0, 0] = M_PER_IN                                   # v1
-        for i in range(n_u):
-            C[1 + i, 1 + i] = 1.0                            # r_i
-        for k in range(n_u - 1):
-            C[7 + k, 1 + n_u + k] = 1.0                      # theta
-            C[n_out + k, 1 + n_u:2 + n_u + k] = 1.0          # thetaA + ... + theta_k
-        C[17, n] = 1.0                                       # psi1
-        C[18, n + 1] = M_PER_IN                              # Y1
-        for j in range(n + 2):                               # Y_rear is linear: apply it to unit vectors
-            e = np.zeros(n + 2)
-            e[j] = 1.0
-            C[19, j] = float(rear_end_global(self.train, e[n], e[n + 1], e[1 + n_u:n])) * M_PER_IN
-        return C
+        """Generalized force (thesis units) per SI input, :data:`INPUT_NAMES` order."""
+        return input_matrix_si(self.train, self.tire_scale)
 
     def reset(self) -> None:
         """Back to rest at time 0 (keeps the caches)."""
