@@ -57,7 +57,7 @@ fmu() {
 }
 
 report() {
-    if [ -f lcvreport/report.py ]; then "$PY" -m lcvreport.report --build-dir build; else log "no report yet"; fi
+    "$PY" -m lcvreport.report --build-dir build
 }
 
 run_tests() {

@@ -86,6 +86,26 @@ class Modes:
         """Largest real part [1/s] (the stability margin, negative when stable)."""
         return float(self.eigenvalues.real.max())
 
+    def dominant(self, state: str, among: tuple[str, ...] | None = None) -> int:
+        """Index of the oscillatory mode (positive imaginary part) in which ``state``
+        has the largest share of the magnitudes of the states ``among`` (all yaw
+        rates by default): e.g. ``dominant("r5")`` is the mode of dolly 2 (Figure 2-2)."""
+        names = list(self.state_names)
+        among = among or tuple(n for n in names if n.startswith("r"))
+        idx = [names.index(n) for n in among]
+        k = names.index(state)
+        best, best_share = -1, -1.0
+        for j in range(self.eigenvalues.size):
+            if self.eigenvalues[j].imag <= 0:
+                continue
+            mags = np.abs(self.shapes[idx, j])
+            share = abs(self.shapes[k, j]) / mags.sum()
+            if share > best_share:
+                best, best_share = j, share
+        if best < 0:
+            raise ValueError("no oscillatory mode")
+        return best
+
     def table(self) -> list[dict]:
         """One row per mode: eigenvalue [1/s], damped frequency [rad/s, Hz], zeta [-]."""
         return [dict(mode=i + 1, real_per_s=float(l.real), imag_per_s=float(l.imag),

@@ -18,6 +18,19 @@ UNIT_NAMES = ("tractor", "trailer1", "dolly1", "trailer2", "dolly2", "trailer3")
 JOINT_LETTERS = ("A", "B", "C", "D", "E")
 
 
+#: Table 3-3 of the thesis: generalized coordinates, their description and unit
+STATE_DESCRIPTIONS = {
+    "v1": ("Tractor Lateral Velocity", "in/s"),
+    "r1": ("Tractor Yaw Rate", "rad/s"), "r2": ("Trailer 1 Yaw Rate", "rad/s"), "r3": ("Dolly 1 Yaw Rate", "rad/s"),
+    "r4": ("Trailer 2 Yaw Rate", "rad/s"), "r5": ("Dolly 2 Yaw Rate", "rad/s"), "r6": ("Trailer 3 Yaw Rate", "rad/s"),
+    "thetaA": ("Articulation Angle at Joint A", "rad"), "thetaB": ("Articulation Angle at Joint B", "rad"),
+    "thetaC": ("Articulation Angle at Joint C", "rad"), "thetaD": ("Articulation Angle at Joint D", "rad"),
+    "thetaE": ("Articulation Angle at Joint E", "rad"),
+}
+#: Table 3-1: unit numbering
+UNIT_LABELS = ("Tractor", "Trailer 1", "Dolly 1", "Trailer 2", "Dolly 2", "Trailer 3")
+
+
 @dataclass(frozen=True)
 class Axle:
     """One axle of one unit.
