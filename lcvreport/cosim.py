@@ -11,12 +11,11 @@ Interface (names, units, defaults) is fixed by SPEC section 5 and listed in
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 
-from .linear import augmented_state_matrix, discretize, rear_end_global, unit_lengths
+from .linear import LRUCache, augmented_state_matrix, discretize, rear_end_global, unit_lengths
 from .model import system_coefficients
 from .presets import PRESETS, load_preset
 from .units import M_PER_IN, N_PER_LBF, NM_PER_LBF_IN
@@ -164,9 +163,8 @@ class LCVEngine:
         self._co = system_coefficients(self.train)
         self.n_units = self.train.n_units
         self.n = 2 * self.n_units
-        self._cache: OrderedDict = OrderedDict()
-        self._eig_cache: dict = {}
-        self._cache_size = cache_size
+        self._cache = LRUCache(cache_size)
+        self._eig_cache = LRUCache(1024)
         self._B_si = self._input_matrix_si()
         self._C = output_matrix(self.train)
         self._L_m = (unit_lengths(self.train) * M_PER_IN).tolist()
@@ -198,19 +196,13 @@ class LCVEngine:
 
     def _step_matrix(self, u_mps: float, h: float) -> np.ndarray:
         """``[[Ad, Bw], [C Ad, C Bw]]``: new state and linear outputs from ``[z, w]`` (cached)."""
-        key = (u_mps, h)
-        hit = self._cache.get(key)
-        if hit is not None:
-            self._cache.move_to_end(key)
-            return hit
-        A, G = augmented_state_matrix(self._co, u_mps / M_PER_IN, self.tire_scale)
-        Ad, Gd = discretize(A, G, h)
-        K = np.hstack([Ad, Gd @ self._B_si])
-        hit = np.vstack([K, self._C @ K])
-        self._cache[key] = hit
-        if len(self._cache) > self._cache_size:
-            self._cache.popitem(last=False)
-        return hit
+        def compute():
+            A, G = augmented_state_matrix(self._co, u_mps / M_PER_IN, self.tire_scale)
+            Ad, Gd = discretize(A, G, h)
+            K = np.hstack([Ad, Gd @ self._B_si])
+            return np.vstack([K, self._C @ K])
+
+        return self._cache.get((u_mps, h), compute)
 
     @property
     def cache_size(self) -> int:
@@ -219,15 +211,12 @@ class LCVEngine:
 
     def max_real_eig(self, u_mps: float) -> float:
         """Largest real part of the eigenvalues at speed ``u_mps`` [1/s] (cached per speed)."""
-        hit = self._eig_cache.get(u_mps)
-        if hit is None:
+        def compute():
             u = u_mps / M_PER_IN
             A = np.linalg.solve(self._co.M(u), self._co.S(u, self.tire_scale))
-            hit = float(np.linalg.eigvals(A).real.max())
-            if len(self._eig_cache) > 1024:
-                self._eig_cache.clear()
-            self._eig_cache[u_mps] = hit
-        return hit
+            return float(np.linalg.eigvals(A).real.max())
+
+        return self._eig_cache.get(u_mps, compute)
 
     # ------------------------------------------------------------------ stepping
     def effective_speed(self, u_mps: float) -> tuple[float, str | None]:

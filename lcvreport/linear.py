@@ -302,6 +302,30 @@ def discretize(A: np.ndarray, G: np.ndarray, h: float) -> tuple[np.ndarray, np.n
     return E[:n, :n], E[:n, n:]
 
 
+class LRUCache:
+    """A small least-recently-used cache: ``get(key, compute)`` returns the cached value
+    or stores ``compute()``; at most ``maxsize`` entries are kept."""
+
+    def __init__(self, maxsize: int = 64):
+        self.maxsize = int(maxsize)
+        self._data: OrderedDict = OrderedDict()
+
+    def get(self, key, compute):
+        """The value for ``key``, computed by ``compute()`` on a miss."""
+        hit = self._data.get(key)
+        if hit is not None:
+            self._data.move_to_end(key)
+            return hit
+        value = compute()
+        self._data[key] = value
+        if len(self._data) > self.maxsize:
+            self._data.popitem(last=False)
+        return value
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+
 @dataclass
 class Discretizer:
     """Cache of exact discretizations of one train keyed by (speed, tire scale, step).
@@ -312,29 +336,26 @@ class Discretizer:
 
     train: Train
     maxsize: int = 64
-    _cache: OrderedDict = field(default_factory=OrderedDict, repr=False)
+    _cache: LRUCache | None = field(default=None, repr=False)
 
     def __call__(self, speed: float, h: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(Ad, Gd) for forward speed [in/s], step h [s] and tire scale [-]."""
-        key = (float(speed), float(h), float(tire_scale))
-        hit = self._cache.get(key)
-        if hit is not None:
-            self._cache.move_to_end(key)
-            return hit
-        co = system_coefficients(self.train)
-        A, G = augmented_state_matrix(co, speed, tire_scale)
-        out = discretize(A, G, h)
-        for arr in out:
-            arr.setflags(write=False)
-        self._cache[key] = out
-        if len(self._cache) > self.maxsize:
-            self._cache.popitem(last=False)
-        return out
+        if self._cache is None:
+            self._cache = LRUCache(self.maxsize)
+
+        def compute():
+            A, G = augmented_state_matrix(system_coefficients(self.train), speed, tire_scale)
+            out = discretize(A, G, h)
+            for arr in out:
+                arr.setflags(write=False)
+            return out
+
+        return self._cache.get((float(speed), float(h), float(tire_scale)), compute)
 
     @property
     def cache_size(self) -> int:
         """Number of cached discretizations."""
-        return len(self._cache)
+        return 0 if self._cache is None else len(self._cache)
 
 
 # ------------------------------------------------------------------ time responses

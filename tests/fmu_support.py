@@ -152,15 +152,31 @@ def response_to_outputs(r: TimeResponse) -> np.ndarray:
     return out
 
 
+#: outputs compared on a common scale: a quantity that is the small residue of cancelling
+#: terms (v1 or Y1 when only trailer 3 is loaded) carries rounding errors set by the size of
+#: the terms, not by its own size.  Measured: the native and the scipy step matrices are
+#: both within 4e-14 (row-relative) of a 40-digit reference, yet Y1 of the two FMUs differed
+#: by 6e-9 of Y1's own peak in a clamped low-speed run -- 1e-13 of the lengths' scale.
+GROUPS = {"velocity": ("v1",), "rates": tuple(f"r{i}" for i in range(1, 7)),
+          "angles": tuple(f"theta{j}" for j in "ABCDE") + ("psi1",),
+          "lengths": tuple(f"y{k}" for k in range(2, 7)) + ("Y1", "Y_rear")}
+
+
 def assert_outputs_close(actual: np.ndarray, ref: np.ndarray, rtol: float = 1e-9):
-    """Every output within ``rtol`` of its peak magnitude over the run."""
+    """Every output within ``rtol`` of the peak magnitude of its group over the run
+    (velocity, yaw rates, angles, lengths: see :data:`GROUPS`)."""
     actual = actual[:, :ref.shape[1]]
     peak = np.abs(ref).max(axis=0)
-    peak[peak == 0] = 1.0
-    err = np.abs(actual - ref).max(axis=0) / peak
+    scale = np.ones_like(peak)
+    for members in GROUPS.values():
+        idx = [OUTPUT_NAMES.index(m) for m in members if OUTPUT_NAMES.index(m) < ref.shape[1]]
+        scale[idx] = max(peak[idx].max(), 1e-300)
+    err = np.abs(actual - ref).max(axis=0) / scale
     worst = int(np.argmax(err))
-    assert err.max() <= rtol, f"{OUTPUT_NAMES[worst]}: relative error {err.max():.3e}"
+    assert err.max() <= rtol, f"{OUTPUT_NAMES[worst]}: error {err.max():.3e} of its group's peak"
     assert np.all(np.isfinite(actual))
+    if ref.shape[1] == len(OUTPUT_NAMES):  # max_real_eig: its own scale
+        np.testing.assert_allclose(actual[:, -1], ref[:, -1], rtol=rtol)
 
 
 def schedule(rng: np.random.Generator, n_steps: int, step_sizes, changes: int = 6, clamp: bool = False):

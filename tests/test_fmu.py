@@ -1,5 +1,6 @@
-"""build/LCV.fmu (pythonfmu): validation, exactness against the package, state,
-reset, several instances, bad input, and the same results in libcosim and ecos."""
+"""Both FMUs, build/LCV.fmu (pythonfmu) and build/LCVNative.fmu (C): validation,
+exactness against the package, state, reset, several instances, bad input, and the
+same results in libcosim and ecos.  Native-only checks are in test_native.py."""
 from __future__ import annotations
 
 import subprocess
@@ -21,9 +22,9 @@ from fmu_support import (Slave, assert_outputs_close, fmu_path, held_inputs, ref
                          schedule)
 
 
-@pytest.fixture(scope="module")
-def fmu():
-    return fmu_path("LCV")
+@pytest.fixture(scope="module", params=["LCV", "LCVNative"])
+def fmu(request):
+    return fmu_path(request.param)
 
 
 def test_fmpy_validate_finds_no_problem(fmu):
@@ -34,7 +35,7 @@ def test_fmpy_validate_finds_no_problem(fmu):
 
 def test_model_description_is_complete(fmu):
     root = ET.fromstring(zipfile.ZipFile(fmu).read("modelDescription.xml"))
-    assert root.get("modelName") == "LCV" and root.find("CoSimulation").get("modelIdentifier") == "LCV"
+    assert root.get("modelName") == fmu.stem and root.find("CoSimulation").get("modelIdentifier") == fmu.stem
     assert root.find("DefaultExperiment") is not None
     units = {u.get("name"): {d.get("name"): float(d.get("factor")) for d in u.findall("DisplayUnit")}
              for u in root.find("UnitDefinitions")}
@@ -119,11 +120,13 @@ def test_hand_driven_variable_step_sizes(fmu, preset):
     assert_outputs_close(got, reference_outputs(preset, steps))
 
 
-def test_max_real_eig_output(fmu):
-    s = Slave(fmu, preset="legal_max", tire_scale=0.8).init()
-    s.set(u=13.4112)
-    lam = eigenvalues(load_preset("legal_max"), 13.4112 / 0.0254, 0.8)
-    assert s.get(["max_real_eig"])[0] == pytest.approx(lam.real.max(), rel=1e-9)
+@pytest.mark.parametrize("preset", PRESETS)
+def test_max_real_eig_output(fmu, preset):
+    s = Slave(fmu, preset=preset, tire_scale=0.8).init()
+    for mph in (5.0, 18.5, 30.0, 50.0, 90.0):
+        s.set(u=mph * 0.44704)
+        lam = eigenvalues(load_preset(preset), mph * 17.6, 0.8)
+        assert s.get(["max_real_eig"])[0] == pytest.approx(lam.real.max(), rel=1e-9)
     s.free()
 
 
@@ -187,10 +190,15 @@ BAD_PARAMETERS = [("preset", "aucant"), ("preset", ""), ("tire_scale", 0.0), ("t
 
 @pytest.mark.parametrize("name, value", BAD_PARAMETERS)
 def test_bad_parameter_is_logged_and_every_step_refused(fmu, name, value):
-    """pythonfmu cannot fail fmi2ExitInitializationMode safely (see fmu_src/LCV.py):
-    the error is logged there, naming the parameter, and every fmi2DoStep is refused."""
+    """LCVNative fails fmi2ExitInitializationMode with fmi2Error; pythonfmu cannot fail it
+    safely (see fmu_src/LCV.py), so LCV logs the error there. Both name the parameter in
+    the log and refuse every fmi2DoStep."""
     s = Slave(fmu, **{name: value})
-    s.fmu.exitInitializationMode()
+    if fmu.stem == "LCVNative":
+        with pytest.raises(FMICallException):
+            s.fmu.exitInitializationMode()
+    else:
+        s.fmu.exitInitializationMode()
     assert any(name in m for m in s.log.messages(min_status=3)), s.log.records
     n_logged = len(s.log.messages(min_status=3))
     with pytest.raises(FMICallException):

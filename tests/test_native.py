@@ -1,5 +1,6 @@
-"""build/LCVNative.fmu (C99): same interface and results as LCV.fmu, no Python at run
-time, a C host, other masters, bad input, memory (valgrind, marked slow)."""
+"""build/LCVNative.fmu (C99) beyond what test_fmu.py checks for both FMUs: the same
+interface and results as LCV.fmu, no Python at run time, a C host, bad input in the C
+host, ecos' command-line runner, memory (valgrind, marked slow)."""
 from __future__ import annotations
 
 import csv
@@ -104,38 +105,6 @@ def test_native_and_python_fmus_agree(native, lcv, preset, steps_seed):
     np.testing.assert_allclose(outs[0][:, -1], outs[1][:, -1], rtol=1e-9)  # max_real_eig
 
 
-@pytest.mark.parametrize("preset", PRESETS)
-def test_max_real_eig_matches_numpy(native, preset):
-    s = Slave(native, preset=preset, tire_scale=1.3).init()
-    for mph in (5.0, 18.5, 30.0, 50.0, 70.0, 90.0):
-        s.set(u=mph * 0.44704)
-        lam = eigenvalues(load_preset(preset), mph * 17.6, 1.3)
-        assert s.get(["max_real_eig"])[0] == pytest.approx(lam.real.max(), rel=1e-9)
-    s.free()
-
-
-def test_state_get_set_serialize_and_reset(native):
-    steps = schedule(np.random.default_rng(9), 60, [0.01, 0.05])
-    s = Slave(native, preset="legal_max").init()
-    run_schedule(s, steps[:20])
-    st = s.fmu.getFMUstate()
-    blob = s.fmu.serializeFMUstate(st)
-    a = run_schedule(s, steps[20:], t0=0.5)
-    s.fmu.setFMUstate(st)
-    b = run_schedule(s, steps[20:], t0=0.5)
-    s.fmu.setFMUstate(s.fmu.deSerializeFMUstate(blob))
-    c = run_schedule(s, steps[20:], t0=0.5)
-    np.testing.assert_array_equal(a, b)
-    np.testing.assert_array_equal(a, c)
-    s.fmu.reset()
-    s.fmu.setupExperiment(startTime=0.0)
-    s.fmu.enterInitializationMode()
-    s.fmu.setString([s.vr["preset"]], ["legal_max"])
-    s.fmu.exitInitializationMode()
-    np.testing.assert_array_equal(run_schedule(s, steps), run_schedule(Slave(native, instance="b", preset="legal_max").init(), steps))
-    s.free()
-
-
 # ------------------------------------------------------------------ the C host
 def _run_host(c_host, unzipped, script: str, env_extra: dict | None = None):
     d, guid, _ = unzipped
@@ -221,13 +190,6 @@ def test_zero_speed_clamps_with_a_warning_in_the_c_host(c_host, unzipped):
 
 
 # ------------------------------------------------------------- other masters
-def test_ecos_and_libcosim_run_it(native):
-    from test_fmu import _ecos_series, _fmpy_series, _libcosim_series
-    ref = _fmpy_series(native, "aucnat", 0.01)
-    assert_outputs_close(_ecos_series(native, "aucnat", 0.01), ref, rtol=1e-12)
-    assert_outputs_close(_libcosim_series(native, "aucnat", 0.01), ref, rtol=1e-12)
-
-
 def test_ecos_command_line_runner(native, tmp_path):
     import ecospy
     ecos = Path(ecospy.__file__).parent / "binaries" / "ecos"

@@ -112,15 +112,22 @@ typedef struct {
 /* ------------------------------------------------------------------ logging */
 static void logmsg(Instance *c, fmi2Status status, const char *category, const char *fmt, ...)
 {
-    char buf[1024];
+    char buf[1024], esc[2048];
     va_list ap;
+    size_t j = 0;
     if (!c || !c->cb.logger) return;
     if (!c->logging_on && status < fmi2Warning) return;
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
-    /* the message goes through "%s" so that '%' in it is never interpreted */
-    c->cb.logger(c->cb.componentEnvironment, c->instance_name, status, category, "%s", buf);
+    /* The finished text is the format itself (hosts in Python cannot expand varargs);
+       '%' is doubled so that a host that does apply printf formatting prints it as is. */
+    for (size_t i = 0; buf[i] && j + 2 < sizeof esc; ++i) {
+        if (buf[i] == '%') esc[j++] = '%';
+        esc[j++] = buf[i];
+    }
+    esc[j] = '\0';
+    c->cb.logger(c->cb.componentEnvironment, c->instance_name, status, category, esc);
 }
 
 /* ------------------------------------------------------------------ linear algebra */
@@ -181,13 +188,47 @@ static double norm1(const double *A, int n)
     return best;
 }
 
-/* E = exp(A), n x n dense (ld = n), by scaling and squaring with a Pade approximant of
-   degree 3, 5, 7, 9 or 13 chosen from the 1-norm (Higham, SIAM J. Matrix Anal. Appl. 26,
-   2005).  Returns 0 on success. */
+/* ||A^p||_1^(1/p) */
+static double power_norm(const double *Ap, int n, int p) { return pow(norm1(Ap, n), 1.0 / p); }
+
+/* ell(A, m) of Al-Mohy and Higham (2009): extra squarings that keep the backward error
+   of the degree-m Pade approximant at unit roundoff; ||abs(A)^(2m+1)||_1 exactly. */
+static int ell(const double *A, int n, int m)
+{
+    double c;
+    switch (m) {
+    case 3: c = 100800.; break;
+    case 5: c = 10059033600.; break;
+    case 7: c = 4487938430976000.; break;
+    case 9: c = 5914384781877411840000.; break;
+    default: c = 113250775606021113483283660800000000.; break;
+    }
+    double r[MAXBIG], t[MAXBIG];
+    for (int j = 0; j < n; ++j) r[j] = 1.0;
+    for (int k = 0; k < 2 * m + 1; ++k) {       /* r <- r |A| : column sums of |A|^(k+1) */
+        for (int j = 0; j < n; ++j) {
+            double v = 0.0;
+            for (int i = 0; i < n; ++i) v += r[i] * fabs(A[i * n + j]);
+            t[j] = v;
+        }
+        memcpy(r, t, sizeof(double) * n);
+    }
+    double abs_pow = 0.0;
+    for (int j = 0; j < n; ++j) if (r[j] > abs_pow) abs_pow = r[j];
+    double nrm = norm1(A, n);
+    if (abs_pow == 0.0 || nrm == 0.0) return 0;
+    double alpha = abs_pow / (nrm * c);
+    int value = (int)ceil(log2(alpha / ldexp(1.0, -53)) / (2 * m));
+    return value > 0 ? value : 0;
+}
+
+/* E = exp(A), n x n dense (ld = n): scaling and squaring with a Pade approximant of
+   degree 3, 5, 7, 9 or 13, the degree and the number of squarings chosen from the norms
+   of the powers of A as in Al-Mohy and Higham, SIAM J. Matrix Anal. Appl. 31 (2009),
+   Algorithm 5.1 (what scipy.linalg.expm does).  Returns 0 on success. */
 static int expm(const double *Ain, int n, double *E)
 {
-    static const double theta[5] = {1.495585217958292e-2, 2.539398330063230e-1, 9.504178996162932e-1,
-                                    2.097847961257068e0, 5.371920351148152e0};
+    static const double theta13 = 5.371920351148152e0;
     static const double b3[4] = {120., 60., 12., 1.};
     static const double b5[6] = {30240., 15120., 3360., 420., 30., 1.};
     static const double b7[8] = {17297280., 8648640., 1995840., 277200., 25200., 1512., 56., 1.};
@@ -200,25 +241,42 @@ static int expm(const double *Ain, int n, double *E)
     double U[MAXBIG * MAXBIG], V[MAXBIG * MAXBIG], T[MAXBIG * MAXBIG], P[MAXBIG * MAXBIG];
     int nn = n * n, s = 0, m;
     const double *b;
-    double nrm;
 
+    memset(T, 0, sizeof T);   /* (keeps gcc's -Wmaybe-uninitialized quiet; T is set before use) */
     memcpy(A, Ain, sizeof(double) * nn);
-    nrm = norm1(A, n);
-    if (!isfinite(nrm)) return -1;
-    if (nrm <= theta[0]) { m = 3; b = b3; }
-    else if (nrm <= theta[1]) { m = 5; b = b5; }
-    else if (nrm <= theta[2]) { m = 7; b = b7; }
-    else if (nrm <= theta[3]) { m = 9; b = b9; }
+    if (!isfinite(norm1(A, n))) return -1;
+    matmul(A, n, A, n, A2, n, n, n, n);
+    matmul(A2, n, A2, n, A4, n, n, n, n);
+    matmul(A4, n, A2, n, A6, n, n, n, n);
+    double d4 = power_norm(A4, n, 4), d6 = power_norm(A6, n, 6);
+    double eta1 = d4 > d6 ? d4 : d6;
+    if (eta1 <= 1.495585217958292e-2 && ell(A, n, 3) == 0) { m = 3; b = b3; }
+    else if (eta1 <= 2.539398330063230e-1 && ell(A, n, 5) == 0) { m = 5; b = b5; }
     else {
-        m = 13; b = b13;
-        if (nrm > theta[4]) {
-            s = (int)ceil(log2(nrm / theta[4]));
+        matmul(A4, n, A4, n, P, n, n, n, n);
+        double d8 = power_norm(P, n, 8);
+        double eta3 = d6 > d8 ? d6 : d8;
+        if (eta3 <= 9.504178996162932e-1 && ell(A, n, 7) == 0) { m = 7; b = b7; }
+        else if (eta3 <= 2.097847961257068e0 && ell(A, n, 9) == 0) { m = 9; b = b9; }
+        else {
+            matmul(A4, n, A6, n, P, n, n, n, n);
+            double d10 = power_norm(P, n, 10);
+            double eta4 = d8 > d10 ? d8 : d10;
+            double eta5 = eta3 < eta4 ? eta3 : eta4;
+            s = (int)ceil(log2(eta5 / theta13));
             if (s < 0) s = 0;
             double f = ldexp(1.0, -s);
-            for (int i = 0; i < nn; ++i) A[i] *= f;
+            for (int i = 0; i < nn; ++i) P[i] = A[i] * f;
+            s += ell(P, n, 13);
+            m = 13; b = b13;
+            if (s > 0) {
+                f = ldexp(1.0, -s);
+                for (int i = 0; i < nn; ++i) A[i] *= f;
+                double f2 = f * f;
+                for (int i = 0; i < nn; ++i) { A2[i] *= f2; A4[i] *= f2 * f2; A6[i] *= f2 * f2 * f2; }
+            }
         }
     }
-    matmul(A, n, A, n, A2, n, n, n, n);
     if (m <= 9) {
         /* U = A (b[m] A^(m-1) + ... + b[1] I), V = b[m-1] A^(m-1) + ... + b[0] I */
         double Pk[MAXBIG * MAXBIG];
@@ -234,8 +292,6 @@ static int expm(const double *Ain, int n, double *E)
         }
         matmul(A, n, T, n, U, n, n, n, n);
     } else {
-        matmul(A2, n, A2, n, A4, n, n, n, n);
-        matmul(A4, n, A2, n, A6, n, n, n, n);
         for (int i = 0; i < nn; ++i) T[i] = b[13] * A6[i] + b[11] * A4[i] + b[9] * A2[i];
         matmul(A6, n, T, n, P, n, n, n, n);
         for (int i = 0; i < nn; ++i) P[i] += b[7] * A6[i] + b[5] * A4[i] + b[3] * A2[i];
