@@ -103,7 +103,7 @@ def show_table(number: str, caption: str, rows: list[dict], data_dir: str | Path
     from IPython.display import Markdown, display
     write_csv(Path(data_dir) / f"table_{_slug(number)}.csv", rows)
     cols = list(columns) if columns is not None else (list(rows[0].keys()) if rows else [])
-    cells = [[fmt(r.get(c, ""), digits).replace("|", "\\|") for c in cols] for r in rows]
+    cells = [[fmt(r.get(c, ""), digits).replace("|", "\\|").replace("*", "\\*") for c in cols] for r in rows]
     # relative column widths for pandoc (PDF): the dashes of the separator line
     widths = [max([len(c.replace("_", " ").split(" ")[0]) + 4] + [min(len(row[k]), 120) for row in cells])
               for k, c in enumerate(cols)]
