@@ -109,10 +109,12 @@ def c_host_us_per_step(fmu: Path) -> float | None:
         subprocess.run(["gcc", "-O2", "-std=c99", "-o", str(exe), str(src), "-ldl"], check=True)
         unzipped = Path(tmp) / "fmu"
         zipfile.ZipFile(fmu).extractall(unzipped)
-        guid = ET.parse(unzipped / "modelDescription.xml").getroot().get("guid")
+        root = ET.parse(unzipped / "modelDescription.xml").getroot()
+        guid = root.get("guid")
+        vr = {sv.get("name"): sv.get("valueReference") for sv in root.iter("ScalarVariable")}
         best = None
         for _ in range(REPEATS):
-            p = subprocess.run([str(exe), str(unzipped), "LCVNative", guid, "bench", str(int(1e6)), "0.001"],
+            p = subprocess.run([str(exe), str(unzipped), "LCVNative", guid, "bench", str(int(1e6)), "0.001", vr["P61"], vr["y6"]],
                                check=True, capture_output=True, text=True)
             for line in p.stdout.splitlines():
                 if line.startswith("us_per_step"):

@@ -9,8 +9,10 @@
  *       d <t> <h>          fmi2DoStep; prints "status <n>"
  *       g <vr> [<vr>...]   fmi2GetReal; prints "values v1 v2 ..." with %.17g
  *       r                  fmi2Reset then fmi2SetupExperiment and fmi2EnterInitializationMode
- *   c_host DIR IDENTIFIER GUID bench <n_steps> <h>
- *       default parameters, P61 = 1000 N, n steps of h; prints "us_per_step <x>"
+ *   c_host DIR IDENTIFIER GUID bench <n_steps> <h> <vr_in> <vr_out>
+ *       default parameters, input vr_in = 1000 (P61 in N), n steps of h; prints
+ *       "us_per_step <x>" and the output vr_out (y6); the caller reads the value
+ *       references from modelDescription.xml
  *
  * DIR is the unzipped FMU; the library is DIR/binaries/linux64/IDENTIFIER.so.
  * Log messages from the FMU are printed as "log <status> <category> <message>".
@@ -72,7 +74,7 @@ static void *sym(void *lib, const char *name)
 int main(int argc, char **argv)
 {
     if (argc < 5) {
-        fprintf(stderr, "usage: c_host DIR IDENTIFIER GUID script|bench [n h]\n");
+        fprintf(stderr, "usage: c_host DIR IDENTIFIER GUID script | bench n h vr_in vr_out\n");
         return 2;
     }
     const char *dir = argv[1], *id = argv[2], *guid = argv[3], *mode = argv[4];
@@ -104,11 +106,11 @@ int main(int argc, char **argv)
         long n = argc > 5 ? atol(argv[5]) : 1000000;
         double h = argc > 6 ? atof(argv[6]) : 1e-3;
         exitinit(c);
-        /* value references are the same in LCV.fmu and LCVNative.fmu (SPEC section 5 order) */
+        if (argc < 9) { fprintf(stderr, "bench needs: n h vr_in vr_out\n"); return 2; }
         struct timespec t0, t1;
         double t = 0.0, y = 0.0;
-        fmi2ValueReference out_vr = 37;  /* y6 */
-        fmi2ValueReference in_vr = 12;   /* P61 */
+        fmi2ValueReference in_vr = (fmi2ValueReference)atol(argv[7]);
+        fmi2ValueReference out_vr = (fmi2ValueReference)atol(argv[8]);
         double p61 = 1000.0;
         setReal(c, &in_vr, 1, &p61);
         clock_gettime(CLOCK_MONOTONIC, &t0);
@@ -119,7 +121,7 @@ int main(int argc, char **argv)
         clock_gettime(CLOCK_MONOTONIC, &t1);
         getReal(c, &out_vr, 1, &y);
         double us = ((t1.tv_sec - t0.tv_sec) * 1e6 + (t1.tv_nsec - t0.tv_nsec) / 1e3) / (double)n;
-        printf("us_per_step %.6f\ny6 %.17g\n", us, y);
+        printf("us_per_step %.6f\noutput %.17g\n", us, y);
     } else {
         char line[8192];
         while (fgets(line, sizeof line, stdin)) {

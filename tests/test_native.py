@@ -232,12 +232,12 @@ def test_ecos_command_line_runner(native, tmp_path):
 # ------------------------------------------------------------------ memory
 @pytest.mark.slow
 def test_valgrind_memcheck_one_million_steps(c_host, unzipped):
-    d, guid, _ = unzipped
+    d, guid, vr = unzipped
     if shutil.which("valgrind") is None:
         pytest.fail("valgrind is not installed (./build.sh setup installs it)")
     p = subprocess.run(["valgrind", "--tool=memcheck", "--leak-check=full", "--show-leak-kinds=all",
                         "--errors-for-leak-kinds=all", "--error-exitcode=99", str(c_host), str(d), "LCVNative",
-                        guid, "bench", "1000000", "0.001"], capture_output=True, text=True, timeout=3000)
+                        guid, "bench", "1000000", "0.001", str(vr["P61"]), str(vr["y6"])], capture_output=True, text=True, timeout=3000)
     assert p.returncode == 0, p.stderr[-3000:]
     assert "ERROR SUMMARY: 0 errors" in p.stderr
     assert "All heap blocks were freed" in p.stderr
