@@ -16,7 +16,7 @@ export SOURCE_DATE_EPOCH=1312156800   # 2011-08-01, the dissertation's date: rep
 
 # Debian packages: LaTeX route of nbconvert (PDF), MathJax for the offline HTML,
 # TBB for ecos, poppler for PDF checks, valgrind and gcc for the native FMU.
-APT_PACKAGES=(texlive-xetex texlive-fonts-recommended texlive-plain-generic pandoc libjs-mathjax
+APT_PACKAGES=(texlive-xetex texlive-latex-recommended texlive-fonts-recommended texlive-plain-generic pandoc libjs-mathjax
               fonts-dejavu-core libtbb12 poppler-utils valgrind gcc)
 
 log() { printf '[build.sh] %s\n' "$*" >&2; }
@@ -53,11 +53,11 @@ setup() { system_packages; python_env; }
 
 fmu() {
     mkdir -p build
-    "$PY" -m lcvreport.fmu_build --out build
+    "$PY" -m lcvreport.fmu.build --out build
 }
 
 report() {
-    "$PY" -m lcvreport.report --build-dir build
+    "$PY" -m lcvreport.report.build --build-dir build
 }
 
 run_tests() {

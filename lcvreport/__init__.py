@@ -1,30 +1,94 @@
-"""lcvreport: linear yaw-plane model of long combination vehicles (A-trains).
+"""lcvreport: linear yaw-plane dynamics of long combination vehicles.
 
-Reproduces and audits J. J. Patterson, "Effect of conicity and ply steer on long
-combination vehicle yaw plane motion", University of Akron, 2011.
+A tractor or truck pulling any chain of trailers, dollies and full trailers, in the
+thesis form ``M x' = S x + F`` (J. J. Patterson, "Effect of conicity and ply steer on
+long combination vehicle yaw plane motion", University of Akron, 2011), with the
+thesis reproduced and audited, the standard yaw-plane measures, FMUs and reports.
 
-Modules, one job each:
+Where things live (the folders are the layers; each imports only the ones above it)
+----------------------------------------------------------------------------------
+``units``, ``ranges``    conversion factors and unit systems; the one table of valid
+                         ranges of every parameter and input
+``util/``                an LRU cache; numpy-only numerics (equilibrated solve, expm)
+``model/``               **the model core** (numpy only):
+    ``vehicle``          Axle, Unit, Vehicle (SI parameter sets, validated)
+    ``vehicle_file``     vehicle files (TOML, SI): load_vehicle, dumps_vehicle
+    ``presets``          the six thesis vehicles, shipped as vehicle files
+    ``builder``          M, S and the input matrices of any chain (SI or thesis units)
+    ``loads``            residual loads P, T; the 1 % rule; load conventions
+``analysis/``            **linear analysis** (numpy, scipy):
+    ``modes``            eigenvalues, damping, mode shapes
+    ``steady``           steady state -S^-1 F
+    ``geometry``         rear-end offsets (eq. 4.42-4.46), global positions
+    ``discretize``       exact zero-order-hold discretization, its cache
+    ``response``         TimeResponse, simulate, step_response (exact)
+    ``modal``            modal superposition, exact and the thesis' method
+    ``statespace``       named state space; to_statespace (python-control)
+    ``measures``         RA, damping, critical speed, single sine, trim
+``thesis/``              **the reproduction of the dissertation**: its tables (data),
+                         tire fits, the preset conversion, chapter studies, audit
+``fmu/``                 **the FMUs**: interface table, modelDescription writer, the
+                         co-simulation engine (numpy only), builders of the pythonfmu
+                         and the C FMU (sources in the repository's ``fmu_src/``,
+                         installed as ``lcvreport.fmu_src``)
+``report/``              **the reports**: plotting, captions and tables, papermill +
+                         nbconvert orchestration of the thesis report and of the
+                         assessment report of any vehicle (notebooks in ``notebooks/``,
+                         installed as ``lcvreport.notebooks``)
+``cli``                  the ``lcv`` command
 
-``data``      thesis tables (TOML files with units in the key names)
-``vehicle``   parameter-set classes (Axle, Unit, Train)
-``presets``   the thesis vehicles built from the tables
-``tires``     Appendix D fits of tire coefficients against tire load
-``model``     the builder of M, S and input matrices for any N
-``linear``    eigen-analysis, exact (zero-order-hold) response, steady state, modal methods
-``loads``     residual loads P, T, the 1 % rule, conventions, load configurations
-``studies``   chapter III-V studies
-``cosim``     the co-simulation engine behind the FMUs
-``cli``       the ``lcv`` command
+Units
+-----
+SI at every public interface: speeds ``speed_mps`` [m/s], lengths [m], forces [N],
+moments [N*m], states ``v1`` [m/s], ``r`` [rad/s], ``theta`` [rad].  Names of
+dimensional numbers carry their unit (``mass_kg``, ``x_m``, ``speed_mps``,
+``offtracking_m``); the thesis reproduction asks for matrices in the thesis' units
+explicitly (``units=lcvreport.units.THESIS``: in, lbf, s).  Joints are lettered A, B,
+C ... as in thesis Table 3-2 (``thetaA``); the FMUs of SPEC section 9 number them.
+
+Examples
+--------
+>>> import lcvreport
+>>> v = lcvreport.load_preset("aucnat")
+>>> m = lcvreport.modes(v, lcvreport.units.kph_to_mps(88.0))
+>>> m.stable
+True
 """
-from .linear import Modes, TimeResponse, modes, simulate, steady_state, step_response
-from .loads import ResidualLoads, load_vector, one_percent_rule
-from .model import system_coefficients, system_matrices
-from .presets import PRESETS, load_preset
-from .vehicle import Axle, Train, Unit
+from __future__ import annotations
 
-__all__ = [
-    "Axle", "Unit", "Train", "PRESETS", "load_preset", "system_coefficients", "system_matrices",
-    "Modes", "modes", "TimeResponse", "simulate", "step_response", "steady_state",
-    "ResidualLoads", "one_percent_rule", "load_vector",
-]
-__version__ = "0.1.0"
+import importlib
+
+from . import ranges, units
+
+__version__ = "0.2.0"
+
+#: public name -> module that defines it (loaded on first use: importing the package
+#: loads numpy only, so the FMU engine's embedded interpreter stays light)
+_API = {
+    "Axle": "model.vehicle", "Unit": "model.vehicle", "Vehicle": "model.vehicle", "VehicleError": "model.vehicle",
+    "load_vehicle": "model.vehicle_file", "loads_vehicle": "model.vehicle_file",
+    "VehicleFileError": "model.vehicle_file", "dumps_vehicle": "model.vehicle_file",
+    "PRESETS": "model.presets", "load_preset": "model.presets",
+    "system_coefficients": "model.builder", "system_matrices": "model.builder",
+    "ResidualLoads": "model.loads", "one_percent_rule": "model.loads", "load_vector": "model.loads",
+    "Modes": "analysis.modes", "modes": "analysis.modes", "eigenvalues": "analysis.modes",
+    "steady_state": "analysis.steady",
+    "TimeResponse": "analysis.response", "simulate": "analysis.response", "step_response": "analysis.response",
+    "to_statespace": "analysis.statespace",
+    "measure_set": "analysis.measures", "rearward_amplification": "analysis.measures",
+    "critical_speed": "analysis.measures", "least_damping": "analysis.measures", "single_sine": "analysis.measures",
+    "trim": "analysis.measures",
+}
+__all__ = sorted(_API) + ["ranges", "units"]
+
+
+def __getattr__(name: str):
+    if name in _API:
+        value = getattr(importlib.import_module(f".{_API[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'lcvreport' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_API))

@@ -1,25 +1,32 @@
 /*
- * A minimal FMI 2.0 co-simulation host in C99: dlopen, instantiate, step, get.
- * No Python anywhere in the process (unless the FMU itself needs it).
+ * A minimal FMI 2.0 co-simulation host in C99: dlopen, instantiate, step, get, and the
+ * hostile calls of the test suite.  No Python in the process (unless the FMU brings it).
+ * Its own declarations (not the official headers): an importer nobody else wrote.
  *
  *   c_host DIR IDENTIFIER GUID script      commands from stdin, one per line:
- *       S <vr> <text>      fmi2SetString (before "i")
- *       s <vr> <value>     fmi2SetReal
- *       i                  fmi2ExitInitializationMode (fmi2EnterInitializationMode is done at start)
- *       d <t> <h>          fmi2DoStep; prints "status <n>"
- *       g <vr> [<vr>...]   fmi2GetReal; prints "values v1 v2 ..." with %.17g
- *       r                  fmi2Reset then fmi2SetupExperiment and fmi2EnterInitializationMode
+ *       S <vr> <text>      fmi2SetString
+ *       s <vr> <value>     fmi2SetReal (value parsed by strtod: nan, inf, 1e308 ...)
+ *       i                  fmi2ExitInitializationMode (EnterInitializationMode is done at start)
+ *       d <t> <h>          fmi2DoStep
+ *       g <vr> [<vr>...]   fmi2GetReal; prints "values <status> v1 v2 ..." with %.17g
+ *       r                  fmi2Reset, fmi2SetupExperiment, fmi2EnterInitializationMode
+ *       G / P / F          fmi2GetFMUstate / fmi2SetFMUstate / fmi2FreeFMUstate of one slot
+ *       B                  serialize the slot, then deserialize the bytes into the slot
+ *       N <offset>         serialize the slot, write a NaN at byte <offset>, deserialize
+ *       Z <n>              deserialize <n> bytes of garbage (0: empty)
+ *       0                  deserialize from a NULL buffer
+ *       c <n>              <n> cycles of instantiate, initialize, 10 steps, free
+ *       m                  print "rss_kb <resident set size>"
+ *   every call prints "status <n>"; log messages print as "log <status> <category> <message>".
  *   c_host DIR IDENTIFIER GUID bench <n_steps> <h> <vr_in> <vr_out>
- *       default parameters, input vr_in = 1000 (P61 in N), n steps of h; prints
- *       "us_per_step <x>" and the output vr_out (y6); the caller reads the value
- *       references from modelDescription.xml
+ *       n steps of h with input vr_in = 1000; prints "us_per_step <x>" and output vr_out.
  *
  * DIR is the unzipped FMU; the library is DIR/binaries/linux64/IDENTIFIER.so.
- * Log messages from the FMU are printed as "log <status> <category> <message>".
  * Build: gcc -std=c99 -O2 -o c_host c_host.c -ldl
  */
 #define _POSIX_C_SOURCE 200809L
 #include <dlfcn.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,11 +35,13 @@
 
 typedef void *fmi2Component;
 typedef void *fmi2ComponentEnvironment;
+typedef void *fmi2FMUstate;
 typedef unsigned int fmi2ValueReference;
 typedef double fmi2Real;
 typedef int fmi2Boolean;
 typedef const char *fmi2String;
 typedef int fmi2Status;
+typedef char fmi2Byte;
 typedef struct {
     void (*logger)(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
     void *(*allocateMemory)(size_t, size_t);
@@ -50,12 +59,20 @@ typedef fmi2Status (*SetReal_t)(fmi2Component, const fmi2ValueReference *, size_
 typedef fmi2Status (*GetReal_t)(fmi2Component, const fmi2ValueReference *, size_t, fmi2Real *);
 typedef fmi2Status (*SetString_t)(fmi2Component, const fmi2ValueReference *, size_t, const fmi2String *);
 typedef fmi2Status (*DoStep_t)(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean);
+typedef fmi2Status (*GetState_t)(fmi2Component, fmi2FMUstate *);
+typedef fmi2Status (*SetState_t)(fmi2Component, fmi2FMUstate);
+typedef fmi2Status (*StateSize_t)(fmi2Component, fmi2FMUstate, size_t *);
+typedef fmi2Status (*Serialize_t)(fmi2Component, fmi2FMUstate, fmi2Byte *, size_t);
+typedef fmi2Status (*Deserialize_t)(fmi2Component, const fmi2Byte *, size_t, fmi2FMUstate *);
+
+static int quiet = 0;
 
 static void logger(fmi2ComponentEnvironment env, fmi2String inst, fmi2Status st, fmi2String cat, fmi2String msg, ...)
 {
     (void)env; (void)inst;
-    char buf[2048];
+    char buf[4096];
     va_list ap;
+    if (quiet) return;
     va_start(ap, msg);
     vsnprintf(buf, sizeof buf, msg ? msg : "", ap);
     va_end(ap);
@@ -69,6 +86,16 @@ static void *sym(void *lib, const char *name)
     void *f = dlsym(lib, name);
     if (!f) { fprintf(stderr, "missing symbol %s\n", name); exit(3); }
     return f;
+}
+
+static long rss_kb(void)
+{
+    long pages = 0, resident = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (!f) return -1;
+    if (fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = -1;
+    fclose(f);
+    return resident * 4;
 }
 
 int main(int argc, char **argv)
@@ -95,24 +122,28 @@ int main(int argc, char **argv)
     GetReal_t getReal = (GetReal_t)sym(lib, "fmi2GetReal");
     SetString_t setString = (SetString_t)sym(lib, "fmi2SetString");
     DoStep_t doStep = (DoStep_t)sym(lib, "fmi2DoStep");
+    GetState_t getState = (GetState_t)sym(lib, "fmi2GetFMUstate");
+    SetState_t setState = (SetState_t)sym(lib, "fmi2SetFMUstate");
+    GetState_t freeState = (GetState_t)sym(lib, "fmi2FreeFMUstate");
+    StateSize_t stateSize = (StateSize_t)sym(lib, "fmi2SerializedFMUstateSize");
+    Serialize_t serialize = (Serialize_t)sym(lib, "fmi2SerializeFMUstate");
+    Deserialize_t deserialize = (Deserialize_t)sym(lib, "fmi2DeSerializeFMUstate");
 
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
     fmi2Component c = instantiate("host", 1 /* fmi2CoSimulation */, guid, uri, &cb, 0, 1);
-    if (!c) { fprintf(stderr, "instantiate failed\n"); return 4; }
+    if (!c) { printf("instantiate failed\n"); fflush(stdout); return 4; }
     setup(c, 0, 0.0, 0.0, 0, 0.0);
     enter(c);
 
     if (strcmp(mode, "bench") == 0) {
-        long n = argc > 5 ? atol(argv[5]) : 1000000;
-        double h = argc > 6 ? atof(argv[6]) : 1e-3;
-        exitinit(c);
         if (argc < 9) { fprintf(stderr, "bench needs: n h vr_in vr_out\n"); return 2; }
+        long n = atol(argv[5]);
+        double h = atof(argv[6]);
+        exitinit(c);
         struct timespec t0, t1;
-        double t = 0.0, y = 0.0;
-        fmi2ValueReference in_vr = (fmi2ValueReference)atol(argv[7]);
-        fmi2ValueReference out_vr = (fmi2ValueReference)atol(argv[8]);
-        double p61 = 1000.0;
-        setReal(c, &in_vr, 1, &p61);
+        double t = 0.0, y = 0.0, p = 1000.0;
+        fmi2ValueReference in_vr = (fmi2ValueReference)atol(argv[7]), out_vr = (fmi2ValueReference)atol(argv[8]);
+        setReal(c, &in_vr, 1, &p);
         clock_gettime(CLOCK_MONOTONIC, &t0);
         for (long k = 0; k < n; ++k) {
             if (doStep(c, t, h, 1) != 0) { fprintf(stderr, "doStep failed at %ld\n", k); return 5; }
@@ -124,6 +155,7 @@ int main(int argc, char **argv)
         printf("us_per_step %.6f\noutput %.17g\n", us, y);
     } else {
         char line[8192];
+        fmi2FMUstate slot = NULL;
         while (fgets(line, sizeof line, stdin)) {
             char *p = line;
             char cmd = *p++;
@@ -146,8 +178,8 @@ int main(int argc, char **argv)
                 if (sscanf(p, "%127s %127s", a, b) != 2) continue;
                 printf("status %d\n", doStep(c, strtod(a, NULL), strtod(b, NULL), 1));
             } else if (cmd == 'g') {
-                fmi2ValueReference vrs[256]; double vals[256]; size_t n = 0; int off = 0; unsigned v;
-                while (n < 256 && sscanf(p, "%u%n", &v, &off) == 1) { vrs[n++] = v; p += off; }
+                fmi2ValueReference vrs[512]; double vals[512]; size_t n = 0; int off = 0; unsigned v;
+                while (n < 512 && sscanf(p, "%u%n", &v, &off) == 1) { vrs[n++] = v; p += off; }
                 fmi2Status st = getReal(c, vrs, n, vals);
                 printf("values %d", st);
                 for (size_t k = 0; k < n; ++k) printf(" %.17g", vals[k]);
@@ -156,13 +188,62 @@ int main(int argc, char **argv)
                 printf("status %d\n", reset(c));
                 setup(c, 0, 0.0, 0.0, 0, 0.0);
                 enter(c);
+            } else if (cmd == 'G') {
+                printf("status %d\n", getState(c, &slot));
+            } else if (cmd == 'P') {
+                printf("status %d\n", setState(c, slot));
+            } else if (cmd == 'F') {
+                printf("status %d\n", freeState(c, &slot));
+            } else if (cmd == 'B' || cmd == 'N') {
+                size_t size = 0;
+                int offset = cmd == 'N' ? atoi(p) : -1;
+                if (stateSize(c, slot, &size) != 0 || size == 0) { printf("status 3\n"); continue; }
+                fmi2Byte *buf = (fmi2Byte *)malloc(size);
+                fmi2Status st = serialize(c, slot, buf, size);
+                if (offset >= 0 && (size_t)offset + sizeof(double) <= size) {
+                    double nan = NAN;
+                    memcpy(buf + offset, &nan, sizeof nan);
+                }
+                if (st == 0) st = deserialize(c, buf, size, &slot);
+                printf("status %d\n", st);
+                free(buf);
+            } else if (cmd == 'Z') {
+                size_t n = (size_t)atol(p);
+                fmi2Byte *buf = (fmi2Byte *)malloc(n + 1);
+                for (size_t k = 0; k < n; ++k) buf[k] = (fmi2Byte)(37 * k + 11);
+                fmi2FMUstate tmp = NULL;
+                fmi2Status st = deserialize(c, buf, n, &tmp);
+                printf("status %d\n", st);
+                if (tmp) freeState(c, &tmp);
+                free(buf);
+            } else if (cmd == '0') {
+                fmi2FMUstate tmp = NULL;
+                printf("status %d\n", deserialize(c, NULL, 100, &tmp));
+            } else if (cmd == 'c') {
+                long n = atol(p);
+                quiet = 1;
+                for (long k = 0; k < n; ++k) {
+                    fmi2Component d = instantiate("cycle", 1, guid, uri, &cb, 0, 0);
+                    if (!d) { quiet = 0; printf("cycle instantiate failed\n"); break; }
+                    setup(d, 0, 0.0, 0.0, 0, 0.0);
+                    enter(d);
+                    exitinit(d);
+                    for (int j = 0; j < 10; ++j) doStep(d, j * 0.01, 0.01, 1);
+                    terminate(d);
+                    freeinst(d);
+                }
+                quiet = 0;
+                printf("cycles %ld\n", n);
+            } else if (cmd == 'm') {
+                printf("rss_kb %ld\n", rss_kb());
             }
             fflush(stdout);
         }
+        if (slot) freeState(c, &slot);
     }
     terminate(c);
     freeinst(c);
-    dlclose(lib);
     printf("done\n");
+    fflush(stdout);
     return 0;
 }

@@ -1,9 +1,20 @@
-"""Shared fixtures."""
+"""Shared fixtures: presets, example vehicles, the FMUs (built once per test worker)."""
 from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
-from lcvreport.presets import load_preset
+from lcvreport.model.presets import load_preset
+from lcvreport.model.vehicle_file import load_vehicle
+
+ROOT = Path(__file__).resolve().parents[1]
+BUILD = ROOT / "build"
+EXAMPLES = ROOT / "examples" / "vehicles"
+TOOLS = ROOT.parent / "shared" / "tools"
+EXAMPLE_NAMES = ("western_double", "b_double", "truck_full_trailer")
 
 
 @pytest.fixture(scope="session")
@@ -14,3 +25,52 @@ def aucnat():
 @pytest.fixture(scope="session")
 def semi():
     return load_preset("tractor_semitrailer")
+
+
+@pytest.fixture(scope="session", params=EXAMPLE_NAMES)
+def example(request):
+    return load_vehicle(EXAMPLES / f"{request.param}.toml")
+
+
+def _preset_fmu(name: str) -> Path:
+    path = BUILD / f"{name}.fmu"
+    if not path.exists():
+        subprocess.run([sys.executable, "-m", "lcvreport.fmu.build", "--out", str(BUILD)], check=True, cwd=ROOT)
+    assert path.exists(), f"{path} missing: run ./build.sh fmu"
+    return path
+
+
+@pytest.fixture(scope="session")
+def lcv_fmu():
+    """build/LCV.fmu (pythonfmu, SPEC section 5)."""
+    return _preset_fmu("LCV")
+
+
+@pytest.fixture(scope="session")
+def native_fmu():
+    """build/LCVNative.fmu (C99, SPEC section 5)."""
+    return _preset_fmu("LCVNative")
+
+
+@pytest.fixture(scope="session", params=["LCV", "LCVNative"])
+def preset_fmu(request):
+    return _preset_fmu(request.param)
+
+
+@pytest.fixture(scope="session")
+def western_fmus(tmp_path_factory):
+    """Both FMUs of examples/vehicles/western_double.toml, built by lcv fmu."""
+    out = tmp_path_factory.mktemp("western_fmus")
+    p = subprocess.run([sys.executable, "-m", "lcvreport.cli", "fmu", "--vehicle",
+                        str(EXAMPLES / "western_double.toml"), "--out", str(out)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    return {"python": out / "western_double.fmu", "native": out / "western_doubleNative.fmu"}
+
+
+@pytest.fixture(scope="session")
+def c_host(tmp_path_factory):
+    """tests/c_host.c compiled: a plain C FMI host (no Python in the process)."""
+    exe = tmp_path_factory.mktemp("host") / "c_host"
+    subprocess.run(["gcc", "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(exe),
+                    str(ROOT / "tests" / "c_host.c"), "-ldl"], check=True)
+    return exe

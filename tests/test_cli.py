@@ -1,23 +1,35 @@
-"""The `lcv` command-line contract (issue: core), including every bad-argument case."""
+"""The ``lcv`` command-line contract: presets and vehicle files, every command, and every
+hostile argument of issue 8 (no traceback, no inf/NaN with status 0, broken pipes,
+closed and full outputs, streaming in constant memory)."""
 from __future__ import annotations
 
 import io
 import json
 import os
+import resource
 import shutil
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
 
-from lcvreport.cli import run
-from lcvreport.linear import eigenvalues, rear_displacements, steady_state
-from lcvreport.loads import load_vector, one_percent_rule
-from lcvreport.model import system_matrices
-from lcvreport.presets import PRESETS, load_preset
+from lcvreport.analysis.geometry import rear_offsets
+from lcvreport.analysis.modes import eigenvalues
+from lcvreport.analysis.steady import steady_state
+from lcvreport.cli import EXIT_BROKEN_PIPE, run
+from lcvreport.model.builder import system_matrices
+from lcvreport.model.loads import load_vector, one_percent_rule
+from lcvreport.model.presets import PRESETS, load_preset
+from lcvreport.model.vehicle_file import load_vehicle
+from lcvreport.ranges import RANGES
+from lcvreport.units import THESIS
 
-IN = 0.0254  # m per in, typed here on purpose
+from conftest import EXAMPLE_NAMES, EXAMPLES
+
+MPS_PER_MPH = 0.44704       # typed here on purpose
+WESTERN = str(EXAMPLES / "western_double.toml")
 
 
 def lcv(*argv):
@@ -32,112 +44,222 @@ def lcv_json(*argv):
     return json.loads(text)
 
 
-def _lcv_executable():
+def lcv_process(*argv, **kw):
+    """``lcv`` as users run it: the console script, a fresh process."""
     exe = shutil.which("lcv", path=os.path.dirname(sys.executable))
     assert exe, "the console script lcv is not installed next to the test interpreter"
-    return exe
+    return subprocess.run([exe, *argv], capture_output=True, text=True, timeout=120, **kw)
 
 
+# ---------------------------------------------------------------------------- the contract
 def test_console_script_is_installed_and_answers():
-    p = subprocess.run([_lcv_executable(), "eig", "--preset", "aucnat", "--speed-mph", "50", "--json"],
-                       capture_output=True, text=True, check=True)
-    doc = json.loads(p.stdout)
-    assert len(doc["eigenvalues"]) == 12
+    p = lcv_process("eig", "--preset", "aucnat", "--speed-mph", "50", "--json")
+    assert p.returncode == 0 and len(json.loads(p.stdout)["eigenvalues"]) == 12
 
 
 @pytest.mark.parametrize("preset", PRESETS)
 def test_eig_json(preset):
     doc = lcv_json("eig", "--preset", preset, "--speed-mph", "45", "--tire-scale", "0.8")
     lam = np.array([complex(a, b) for a, b in doc["eigenvalues"]])
-    # the CLI uses the generalized eigenproblem (S, M); eigenvalues() uses eig(M^-1 S):
-    # two numerical routes to the same numbers, equal to rounding (~1e-12)
-    np.testing.assert_allclose(lam, eigenvalues(load_preset(preset), 45 * 17.6, 0.8), rtol=1e-10)
+    # the CLI uses the generalized eigenproblem (S, M); eigenvalues() eig(M^-1 S): equal to rounding
+    np.testing.assert_allclose(lam, eigenvalues(load_preset(preset), 45 * MPS_PER_MPH, 0.8), rtol=1e-10)
+    k = doc["least_damped_mode"] - 1
+    assert doc["damping_ratio"][k] == min(z for z, (_r, i) in zip(doc["damping_ratio"], doc["eigenvalues"]) if i > 0)
 
 
-def test_matrices_json_in_thesis_units_with_and_without_load():
+def test_eig_text_marks_the_least_damped_mode():
+    code, text = lcv("eig", "--vehicle", WESTERN, "--speed-kph", "88")
+    assert code == 0 and sum(line.endswith(" *") for line in text.splitlines()) == 2
+    assert "western_double at 88 km/h" in text
+
+
+@pytest.mark.parametrize("name", EXAMPLE_NAMES)
+def test_every_command_works_on_every_example(name):
+    path = str(EXAMPLES / f"{name}.toml")
+    v = load_vehicle(path)
+    last = v.unit_names[-1]
+    eig = lcv_json("eig", "--vehicle", path, "--speed-kph", "88")
+    assert len(eig["eigenvalues"]) == v.n_states
+    steady = lcv_json("steady", "--vehicle", path, "--speed-kph", "88", "--load", last)
+    x = steady_state(v, 88 / 3.6, load_vector(v, one_percent_rule(v, [last])))
+    assert steady["state"]["r1"] == pytest.approx(x[1], rel=1e-12)
+    assert steady["y"][f"y{v.n_units}"] == pytest.approx(rear_offsets(v, x[v.n_units + 1:])[-1], rel=1e-12)
+    code, csv = lcv("simulate", "--vehicle", path, "--speed-kph", "88", "--load", last, "--t-end", "2", "--dt", "0.5")
+    rows = csv.strip().splitlines()
+    assert code == 0 and len(rows) == 6
+    header = rows[0].split(",")
+    assert header[:2] == ["time_s", "v1_m_per_s"] and header[-1] == f"ay{v.n_units}_m_per_s2"
+    mats = lcv_json("matrices", "--vehicle", path, "--speed-kph", "88")
+    assert mats["units"].startswith("SI")
+    np.testing.assert_allclose(mats["M"], system_matrices(v, 88 / 3.6)[0], rtol=1e-14)
+
+
+def test_matrices_json_in_thesis_units_for_presets():
     doc = lcv_json("matrices", "--preset", "tractor_semitrailer", "--speed-mph", "50")
-    assert doc["state"] == ["v1", "r1", "r2", "thetaA"]
-    assert "F" not in doc
-    M, S = system_matrices(load_preset("tractor_semitrailer"), 880.0)
-    np.testing.assert_allclose(doc["M"], M, rtol=1e-15)
-    np.testing.assert_allclose(doc["S"], S, rtol=1e-15)
-    doc = lcv_json("matrices", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer2,trailer3",
-                   "--convention", "thesis")
-    np.testing.assert_allclose(np.abs(doc["F"]), [423, 3008, 9156, 2744, 8021, 1354, 3414, 0, 0, 0, 0, 0], atol=1)
+    assert doc["state"] == ["v1", "r1", "r2", "thetaA"] and "F" not in doc and doc["units"].startswith("thesis")
+    M, S = system_matrices(load_preset("tractor_semitrailer"), 50 * MPS_PER_MPH, units=THESIS)
+    np.testing.assert_allclose(doc["M"], M, rtol=1e-14)
+    np.testing.assert_allclose(doc["S"], S, rtol=1e-14)
+    doc_t = lcv_json("matrices", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer2,trailer3",
+                     "--convention", "thesis")
     doc_c = lcv_json("matrices", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer2,trailer3")
-    np.testing.assert_allclose(np.array(doc_c["F"])[1:], 12 * np.array(doc["F"])[1:], rtol=1e-12)
+    np.testing.assert_allclose(np.array(doc_c["F"])[1:7], 12 * np.array(doc_t["F"])[1:7], rtol=1e-12)
+    si = lcv_json("matrices", "--preset", "aucnat", "--speed-mph", "50", "--units", "si")
+    np.testing.assert_allclose(si["M"], system_matrices(load_preset("aucnat"), 50 * MPS_PER_MPH)[0], rtol=1e-14)
 
 
-@pytest.mark.parametrize("convention", ["consistent", "thesis"])
-def test_steady_json_in_si(convention):
-    train = load_preset("aucnat")
-    doc = lcv_json("steady", "--preset", "aucnat", "--speed-mph", "30", "--load",
-                   "trailer1,dolly1,trailer2,dolly2,trailer3", "--convention", convention)
-    F = load_vector(train, one_percent_rule(train, ["trailer1", "dolly1", "trailer2", "dolly2", "trailer3"]),
-                    convention)
-    x = steady_state(train, 30 * 17.6, F)
-    assert list(doc["state"]) == list(train.state_names)
-    assert doc["state"]["v1"] == pytest.approx(x[0] * IN, rel=1e-12)
-    assert doc["state"]["r1"] == pytest.approx(x[1], rel=1e-12)
+def test_steady_json_in_si():
+    doc = lcv_json("steady", "--preset", "aucnat", "--speed-mph", "30", "--load", "trailer2,trailer3")
+    v = load_preset("aucnat")
+    x = steady_state(v, 30 * MPS_PER_MPH, load_vector(v, one_percent_rule(v, ["trailer2", "trailer3"])))
+    assert doc["state"]["v1"] == pytest.approx(x[0], rel=1e-12)
     assert doc["state"]["thetaC"] == pytest.approx(x[9], rel=1e-12)
-    y = rear_displacements(train, x[7:]) * IN
-    assert list(doc["y"]) == ["y2", "y3", "y4", "y5", "y6"]
-    assert doc["y"]["y6"] == pytest.approx(y[-1], rel=1e-12)
+    assert doc["y"]["y6"] == pytest.approx(rear_offsets(v, x[7:])[-1], rel=1e-12)
 
 
-def test_default_convention_is_consistent():
-    a = lcv_json("steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3")
-    b = lcv_json("steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3", "--convention",
-                 "consistent")
-    assert a == b
+def test_speed_in_kph_and_mph_agree():
+    a = lcv_json("eig", "--preset", "aucnat", "--speed-kph", str(50 * 1.609344))
+    b = lcv_json("eig", "--preset", "aucnat", "--speed-mph", "50")
+    np.testing.assert_allclose(a["eigenvalues"], b["eigenvalues"], rtol=1e-10)
 
 
-def test_human_readable_tables():
-    code, text = lcv("eig", "--preset", "aucnat", "--speed-mph", "50")
-    assert code == 0 and "zeta" in text and "Re [1/s]" in text
-    code, text = lcv("steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3")
-    assert code == 0 and "y6" in text and " m " in text
-    code, text = lcv("matrices", "--preset", "tractor_semitrailer", "--speed-mph", "50")
-    assert code == 0 and "M =" in text
+def test_simulate_json_is_honoured_and_equals_the_csv():
+    code, text = lcv("simulate", "--preset", "tractor_semitrailer", "--speed-mph", "50", "--load", "trailer1",
+                     "--t-end", "1", "--dt", "0.25", "--json")
+    doc = json.loads(text)
+    code2, csv = lcv("simulate", "--preset", "tractor_semitrailer", "--speed-mph", "50", "--load", "trailer1",
+                     "--t-end", "1", "--dt", "0.25")
+    rows = [list(map(float, r.split(","))) for r in csv.strip().splitlines()[1:]]
+    assert code == code2 == 0 and doc["columns"] == csv.splitlines()[0].split(",")
+    np.testing.assert_allclose(doc["rows"], rows, rtol=1e-9)
 
 
+def test_presets_list():
+    code, text = lcv("presets")
+    assert code == 0 and [line.split()[0] for line in text.strip().splitlines()] == list(PRESETS)
+    assert lcv_json("presets") == {"presets": list(PRESETS)}
+
+
+# ---------------------------------------------------------------------------- bad arguments: exit 2, one line
 BAD = [
-    (["eig", "--preset", "nope", "--speed-mph", "50"], "--preset", "aucnat"),
-    (["eig", "--preset", "aucnat", "--speed-mph", "0"], "--speed-mph", "> 0"),
-    (["eig", "--preset", "aucnat", "--speed-mph", "-5"], "--speed-mph", "> 0"),
-    (["eig", "--preset", "aucnat", "--speed-mph", "fast"], "--speed-mph", "> 0"),
-    (["eig", "--preset", "aucnat", "--speed-mph", "inf"], "--speed-mph", "> 0"),
-    (["eig", "--preset", "aucnat", "--speed-mph", "50", "--tire-scale", "0"], "--tire-scale", "> 0"),
-    (["eig", "--preset", "aucnat", "--speed-mph", "50", "--tire-scale", "-1"], "--tire-scale", "> 0"),
-    (["eig", "--preset", "aucnat", "--speed-mph", "50", "--tire-scale", "nan"], "--tire-scale", "> 0"),
-    (["steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer4"], "--load", "trailer3"),
-    (["steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer2,,trailer3"], "--load", "trailer1"),
-    (["steady", "--preset", "tractor_semitrailer", "--speed-mph", "50", "--load", "trailer2"], "--load", "trailer1"),
-    (["matrices", "--preset", "aucnat", "--speed-mph", "50", "--load", "dolly7"], "--load", "dolly1"),
-    (["steady", "--preset", "aucnat", "--speed-mph", "50"], "--load", "required"),
-    (["steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3", "--convention", "si"],
-     "--convention", "consistent"),
-    (["eig", "--speed-mph", "50"], "--preset", "required"),
-    (["frobnicate"], "COMMAND", "eig"),
-    ([], "COMMAND", "required"),
-    (["eig", "--preset", "legal_max", "--speed-mph", "50", "--masses", "unrounded"], "--masses", "aucnat"),
+    (["eig", "--speed-mph", "50"], "one of the arguments --preset --vehicle is required"),
+    (["eig", "--preset", "aucnat"], "one of the arguments --speed-kph --speed-mph is required"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "50", "--speed-kph", "80"], "not allowed with argument"),
+    (["eig", "--preset", "aucnat", "--vehicle", WESTERN, "--speed-mph", "50"], "not allowed with argument"),
+    (["eig", "--preset", "nope", "--speed-mph", "50"], "unknown preset 'nope'"),
+    (["eig", "--vehicle", "/nonexistent.toml", "--speed-mph", "50"], "cannot read"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "fast"], "must be a number"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "1e308"], "--speed-mph: must be in [0.2237, 156.6] mph"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "1e6"], "must be in [0.2237, 156.6] mph"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "1e300"], "must be in"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "1e-100"], "must be in"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "1e-300"], "must be in"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "-5"], "must be in"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "nan"], "must be in"),
+    (["eig", "--preset", "aucnat", "--speed-kph", "inf"], "must be in [0.36, 252] km/h"),
+    (["eig", "--preset", "aucnat", "--speed-mph", "50", "--tire-scale", "1e200"], "--tire-scale: must be in [0.01, 100]"),
+    (["steady", "--preset", "aucnat", "--speed-mph", "50", "--tire-scale", "5e-324", "--load", "trailer3"],
+     "--tire-scale: must be in"),
+    (["steady", "--preset", "aucnat", "--speed-mph", "50"], "the following arguments are required: --load"),
+    (["steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer9"], "unknown unit 'trailer9'"),
+    (["steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer2,trailer2"], "listed twice"),
+    (["steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer2,"], "comma list"),
+    (["steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer2", "--convention", "x"], "invalid choice"),
+    (["eig", "--preset", "empty", "--speed-mph", "50", "--masses", "unrounded"], "unrounded masses are known only"),
+    (["eig", "--vehicle", WESTERN, "--speed-mph", "50", "--masses", "unrounded"], "only presets"),
+    (["simulate", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3", "--t-end", "1e9"],
+     "--t-end: must be in (0, 86400] s"),
+    (["simulate", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3", "--dt", "1e-320"],
+     "--dt: must be in [1e-06, 3600] s"),
+    (["simulate", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3", "--t-end", "1", "--dt", "5"],
+     "is longer than --t-end"),
+    (["simulate", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3", "--t-end", "10", "--dt", "0.3"],
+     "does not divide --t-end 10 s into whole steps"),
+    (["simulate", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3", "--t-end", "80000", "--dt", "0.001"],
+     "at most 10000000"),
+    (["measures", "--preset", "aucnat", "--speed-kph", "88", "--load", "dolly9"], "unknown unit 'dolly9'"),
+    (["frobnicate"], "invalid choice"),
+    ([], "the following arguments are required: COMMAND"),
 ]
 
 
-@pytest.mark.parametrize("argv, names, valid", BAD)
-def test_bad_arguments_exit_nonzero_with_one_line(argv, names, valid, capsys):
-    code, out = lcv(*argv)
+@pytest.mark.parametrize("argv, message", BAD, ids=[" ".join(a)[:70] for a, _m in BAD])
+def test_bad_arguments_exit_2_with_one_line(argv, message, capsys):
+    code, text = lcv(*argv)
     err = capsys.readouterr().err
-    assert code != 0
-    assert out == ""
+    assert code == 2 and text == ""
     lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert names in lines[0] and valid in lines[0], lines[0]
-    assert "Traceback" not in err
+    assert len(lines) == 1 and lines[0].startswith("lcv: error: ") and message in lines[0], err
 
 
-def test_bad_argument_through_the_console_script():
-    p = subprocess.run([_lcv_executable(), "steady", "--preset", "aucnat", "--speed-mph", "50", "--load", "x"],
-                       capture_output=True, text=True)
-    assert p.returncode == 2 and p.stdout == ""
-    assert len(p.stderr.strip().splitlines()) == 1 and "--load" in p.stderr
+def test_static_load_missing_for_the_1_percent_rule_is_named(tmp_path, capsys):
+    text = (EXAMPLES / "b_double.toml").read_text()
+    body = "\n".join(line for line in text.splitlines() if not line.strip().startswith("static_load_N"))
+    f = tmp_path / "noload.toml"
+    f.write_text(body + "\n")
+    code, _ = lcv("steady", "--vehicle", str(f), "--speed-kph", "88", "--load", "rear_trailer")
+    err = capsys.readouterr().err
+    assert code == 2 and "static_load_N is needed by the 1 % rule" in err and 'unit "rear_trailer"' in err
+
+
+# ---------------------------------------------------------------------------- outputs that cannot be written
+def test_broken_pipe_ends_quietly():
+    """`lcv presets | head -1` and `lcv simulate ... | head -1`: no message, status 141 (as SIGPIPE)."""
+    exe = shutil.which("lcv", path=os.path.dirname(sys.executable))
+    for cmd in (f"{exe} presets | head -1",
+                f"{exe} simulate --preset aucnat --speed-mph 50 --load trailer3 --t-end 3600 --dt 0.001 | head -1"):
+        p = subprocess.run(["bash", "-c", f"set -o pipefail; {cmd}"], capture_output=True, text=True, timeout=120)
+        assert p.stderr == "", p.stderr
+        assert p.returncode == EXIT_BROKEN_PIPE and len(p.stdout.splitlines()) == 1
+
+
+def test_full_disk_is_one_line_and_exit_1():
+    for argv in (["presets"], ["eig", "--preset", "aucnat", "--speed-mph", "50", "--json"],
+                 ["simulate", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3"]):
+        with open("/dev/full", "w") as full:
+            p = subprocess.run([shutil.which("lcv", path=os.path.dirname(sys.executable)), *argv], stdout=full,
+                               stderr=subprocess.PIPE, text=True, timeout=120)
+        lines = p.stderr.strip().splitlines()
+        assert p.returncode == 1 and len(lines) == 1, p.stderr
+        assert "cannot write the output" in lines[0] and "No space left on device" in lines[0]
+
+
+def test_closed_stdout_is_an_error_not_a_silent_success():
+    exe = shutil.which("lcv", path=os.path.dirname(sys.executable))
+    p = subprocess.run(["bash", "-c", f"{exe} presets >&-"], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 1 and "standard output is closed" in p.stderr
+
+
+def test_no_output_is_ever_not_finite():
+    """A vehicle unstable at the speed grows without bound in a long run: refused, not printed."""
+    code, text = lcv("simulate", "--preset", "empty", "--speed-kph", "150", "--tire-scale", "0.05", "--load",
+                     "trailer3", "--t-end", "86400", "--dt", "60", "--json")
+    assert code == 1
+    assert "inf" not in text.lower() and "nan" not in text.lower()
+
+
+def test_simulate_streams_its_first_row_at_once_in_constant_memory():
+    """10^6 rows: the first arrives within seconds and memory stays flat (nothing is kept)."""
+    exe = shutil.which("lcv", path=os.path.dirname(sys.executable))
+    cmd = [exe, "simulate", "--preset", "aucnat", "--speed-mph", "50", "--load", "trailer3", "--t-end", "1000",
+           "--dt", "0.001"]
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    header = proc.stdout.readline()
+    first = proc.stdout.readline()
+    latency = time.perf_counter() - t0
+    count = 0
+    for _line in proc.stdout:
+        count += 1
+        if count == 200_000:
+            break
+    proc.kill()
+    proc.wait()
+    assert header.startswith("time_s,") and first.startswith("0,")
+    assert latency < 10.0
+    maxrss_mb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+    assert maxrss_mb < 400, maxrss_mb
+
+
+def test_ranges_table_is_what_the_cli_enforces():
+    assert RANGES["speed"].high == 70.0 and RANGES["output_rows"].high == 1e7

@@ -1,0 +1,479 @@
+/*
+ * The FMI 2.0 co-simulation API of the native FMU and its state machine, once for
+ * every vehicle (cf. Reference-FMUs src/fmi2Functions.c): each call checks the
+ * instance, its arguments and the phase it is allowed in (MASK_*), then calls the
+ * model (model.c).  No call sequence or argument returns fmi2Fatal, loops forever or
+ * touches memory it does not own; a refused call returns fmi2Error with a log message
+ * that names what was wrong.
+ *
+ * Built with the official FMI 2.0 headers (fmi2Functions.h, shipped by fmpy) and the
+ * generated config.h / vehicle_data.h.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "model.h"
+
+/* phases a call is allowed in */
+#define ANY_PHASE (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError)
+#define MASK_fmi2SetupExperiment PhaseInstantiated
+#define MASK_fmi2EnterInitializationMode PhaseInstantiated
+#define MASK_fmi2ExitInitializationMode PhaseInitializationMode
+#define MASK_fmi2Terminate (PhaseStepComplete | PhaseError)
+#define MASK_fmi2DoStep PhaseStepComplete
+#define MASK_fmi2GetReal ANY_PHASE
+#define MASK_fmi2SetReal (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete)
+#define MASK_fmi2SetString (PhaseInstantiated | PhaseInitializationMode)
+#define MASK_fmi2GetString ANY_PHASE
+
+static const char *phase_name(int phase)
+{
+    switch (phase) {
+    case PhaseInstantiated: return "Instantiated";
+    case PhaseInitializationMode: return "InitializationMode";
+    case PhaseStepComplete: return "StepComplete";
+    case PhaseTerminated: return "Terminated";
+    default: return "Error";
+    }
+}
+
+/* The finished text is passed as the message itself, with '%' doubled: hosts that apply
+   printf formatting print it as is, hosts that do not (Python hosts) get the text. */
+static void logmsg(ModelInstance *c, fmi2Status status, const char *fmt, ...)
+{
+    char buf[1200], esc[2400];
+    va_list ap;
+    size_t j = 0;
+    if (!c || !c->cb.logger) return;
+    if (!c->logging_on && status < fmi2Warning) return;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    for (size_t i = 0; buf[i] && j + 2 < sizeof esc; ++i) {
+        if (buf[i] == '%') esc[j++] = '%';
+        esc[j++] = buf[i];
+    }
+    esc[j] = '\0';
+    const char *category = status == fmi2Warning ? "logStatusWarning" : status >= fmi2Error ? "logStatusError"
+                                                                                              : "logAll";
+    c->cb.logger(c->cb.componentEnvironment, c->name, status, category, esc);
+}
+
+/* check the instance and the phase; on failure log and return fmi2Error */
+static int allowed(ModelInstance *c, const char *function, int mask)
+{
+    if (!c) return 0;
+    if (!(c->s.phase & mask)) {
+        logmsg(c, fmi2Error, "%s must not be called in phase %s", function, phase_name(c->s.phase));
+        return 0;
+    }
+    return 1;
+}
+
+#define BEGIN_FUNCTION(F) \
+    ModelInstance *c = (ModelInstance *)comp; \
+    if (!allowed(c, "fmi2" #F, MASK_fmi2##F)) return fmi2Error;
+
+/* ------------------------------------------------------------------ inquiry and set-up */
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Status fmi2SetDebugLogging(fmi2Component comp, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[])
+{
+    (void)categories;
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    if (nCategories > 0 && !categories) {
+        logmsg(c, fmi2Error, "fmi2SetDebugLogging: %u categories but no array", (unsigned)nCategories);
+        return fmi2Error;
+    }
+    c->logging_on = loggingOn;
+    return fmi2OK;
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn)
+{
+    (void)fmuResourceLocation; (void)visible;
+    if (!functions || !functions->logger) return NULL;
+    const char *name = instanceName ? instanceName : LCV_MODEL_IDENTIFIER_TEXT;
+    if (fmuType != fmi2CoSimulation) {
+        functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
+                          LCV_MODEL_IDENTIFIER_TEXT " supports co-simulation only");
+        return NULL;
+    }
+    if (!fmuGUID || strcmp(fmuGUID, LCV_GUID) != 0) {
+        functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
+                          "guid mismatch: the modelDescription.xml does not belong to this binary");
+        return NULL;
+    }
+    ModelInstance *c = (ModelInstance *)calloc(1, sizeof(ModelInstance));
+    if (!c) {
+        functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError", "out of memory");
+        return NULL;
+    }
+    memcpy((void *)&c->cb, functions, sizeof(fmi2CallbackFunctions));
+    c->name = (char *)malloc(strlen(name) + 1);
+    if (!c->name) { free(c); return NULL; }
+    strcpy(c->name, name);
+    c->logging_on = loggingOn;
+    model_reset(c);
+    return c;
+}
+
+void fmi2FreeInstance(fmi2Component comp)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return;
+    free(c->name);
+    free(c);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime)
+{
+    (void)toleranceDefined; (void)tolerance; (void)stopTimeDefined; (void)stopTime;
+    BEGIN_FUNCTION(SetupExperiment)
+    if (!isfinite(startTime)) {
+        logmsg(c, fmi2Error, "fmi2SetupExperiment: startTime is not finite (%g)", startTime);
+        return fmi2Error;
+    }
+    c->s.time = startTime;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component comp)
+{
+    BEGIN_FUNCTION(EnterInitializationMode)
+    c->s.phase = PhaseInitializationMode;
+    return fmi2OK;
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component comp)
+{
+    BEGIN_FUNCTION(ExitInitializationMode)
+    double t0 = c->s.time;
+    if (model_exit_initialization(c) != 0) {
+        snprintf(c->s.error, sizeof c->s.error, "%s", c->msg);
+        c->s.phase = PhaseError;
+        logmsg(c, fmi2Error, "%s; every doStep will be refused (fmi2Reset to start again)", c->s.error);
+        return fmi2Error;
+    }
+    c->s.time = t0;
+    c->s.phase = PhaseStepComplete;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Terminate(fmi2Component comp)
+{
+    BEGIN_FUNCTION(Terminate)
+    c->s.phase = PhaseTerminated;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component comp)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    model_reset(c);
+    return fmi2OK;
+}
+
+/* ------------------------------------------------------------------ values */
+fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
+{
+    BEGIN_FUNCTION(GetReal)
+    if (nvr == 0) return fmi2OK;
+    if (!vr || !value) { logmsg(c, fmi2Error, "fmi2GetReal: null array"); return fmi2Error; }
+    if (model_get_real(c, vr, nvr, value) != 0) {
+        logmsg(c, fmi2Error, "%s", c->msg);
+        return fmi2Error;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[])
+{
+    BEGIN_FUNCTION(SetReal)
+    if (nvr == 0) return fmi2OK;
+    if (!vr || !value) { logmsg(c, fmi2Error, "fmi2SetReal: null array"); return fmi2Error; }
+    fmi2Status status = fmi2OK;
+    for (size_t i = 0; i < nvr; ++i) {
+        if (model_set_real(c, vr[i], value[i]) != 0) {
+            logmsg(c, fmi2Error, "%s", c->msg);
+            status = fmi2Error;
+        }
+    }
+    return status;
+}
+
+fmi2Status fmi2GetString(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, fmi2String value[])
+{
+    BEGIN_FUNCTION(GetString)
+    if (nvr == 0) return fmi2OK;
+    if (!vr || !value) { logmsg(c, fmi2Error, "fmi2GetString: null array"); return fmi2Error; }
+    fmi2Status status = fmi2OK;
+    for (size_t i = 0; i < nvr; ++i) {
+        if (model_get_string(c, vr[i], &value[i]) != 0) {
+            logmsg(c, fmi2Error, "%s", c->msg);
+            status = fmi2Error;
+        }
+    }
+    return status;
+}
+
+fmi2Status fmi2SetString(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[])
+{
+    BEGIN_FUNCTION(SetString)
+    if (nvr == 0) return fmi2OK;
+    if (!vr || !value) { logmsg(c, fmi2Error, "fmi2SetString: null array"); return fmi2Error; }
+    fmi2Status status = fmi2OK;
+    for (size_t i = 0; i < nvr; ++i) {
+        if (model_set_string(c, vr[i], value[i]) != 0) {
+            logmsg(c, fmi2Error, "%s", c->msg);
+            status = fmi2Error;
+        }
+    }
+    return status;
+}
+
+static fmi2Status no_variables(fmi2Component comp, size_t nvr, const char *function, const char *type)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    if (nvr == 0) return fmi2OK;
+    logmsg(c, fmi2Error, "%s: this FMU has no %s variables", function, type);
+    return fmi2Error;
+}
+
+fmi2Status fmi2GetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[])
+{
+    (void)vr; (void)value;
+    return no_variables(comp, nvr, "fmi2GetInteger", "Integer");
+}
+
+fmi2Status fmi2SetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[])
+{
+    (void)vr; (void)value;
+    return no_variables(comp, nvr, "fmi2SetInteger", "Integer");
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[])
+{
+    (void)vr; (void)value;
+    return no_variables(comp, nvr, "fmi2GetBoolean", "Boolean");
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[])
+{
+    (void)vr; (void)value;
+    return no_variables(comp, nvr, "fmi2SetBoolean", "Boolean");
+}
+
+/* ------------------------------------------------------------------ stepping */
+fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+                      fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint)
+{
+    (void)currentCommunicationPoint; (void)noSetFMUStatePriorToCurrentCommunicationPoint;
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    if (c->s.phase == PhaseError) {
+        logmsg(c, fmi2Error, "%s; every doStep will be refused (fmi2Reset to start again)", c->s.error);
+        return fmi2Error;
+    }
+    if (!allowed(c, "fmi2DoStep", MASK_fmi2DoStep)) return fmi2Error;
+    int r = model_do_step(c, communicationStepSize);
+    if (r < 0) {
+        logmsg(c, fmi2Error, "%s", c->msg);
+        return fmi2Error;
+    }
+    if (r > 0) logmsg(c, fmi2Warning, "%s", c->msg);
+    return fmi2OK;
+}
+
+fmi2Status fmi2CancelStep(fmi2Component comp)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (c) logmsg(c, fmi2Error, "fmi2CancelStep: steps are not asynchronous");
+    return fmi2Error;
+}
+
+/* ------------------------------------------------------------------ FMU state */
+#define STATE_MAGIC 0x4C43564EU          /* "LCVN" */
+typedef struct {
+    unsigned magic;
+    unsigned size;
+    char guid[64];
+    ModelState s;
+} Snapshot;
+
+static int snapshot_ok(ModelInstance *c, const Snapshot *snap)
+{
+    if (snap->magic != STATE_MAGIC || snap->size != sizeof(Snapshot) ||
+        memchr(snap->guid, '\0', sizeof snap->guid) == NULL || strcmp(snap->guid, LCV_GUID) != 0) {
+        logmsg(c, fmi2Error, "the FMU state was not written by this FMU (another model or version)");
+        return 0;
+    }
+    if (model_check_state(c, &snap->s) != 0) {
+        logmsg(c, fmi2Error, "%s", c->msg);
+        return 0;
+    }
+    return 1;
+}
+
+fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    if (!state) { logmsg(c, fmi2Error, "fmi2GetFMUstate: null pointer"); return fmi2Error; }
+    Snapshot *snap = (Snapshot *)(*state);
+    if (!snap) {
+        snap = (Snapshot *)calloc(1, sizeof(Snapshot));
+        if (!snap) { logmsg(c, fmi2Error, "fmi2GetFMUstate: out of memory"); return fmi2Error; }
+    }
+    snap->magic = STATE_MAGIC;
+    snap->size = (unsigned)sizeof(Snapshot);
+    memset(snap->guid, 0, sizeof snap->guid);
+    snprintf(snap->guid, sizeof snap->guid, "%s", LCV_GUID);
+    snap->s = c->s;
+    *state = snap;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate state)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    const Snapshot *snap = (const Snapshot *)state;
+    if (!snap) { logmsg(c, fmi2Error, "fmi2SetFMUstate: null state"); return fmi2Error; }
+    if (!snapshot_ok(c, snap)) return fmi2Error;
+    int same = c->s.vehicle == snap->s.vehicle && c->s.tire_scale == snap->s.tire_scale;
+    c->s = snap->s;
+    model_state_restored(c, same);
+    return fmi2OK;
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state)
+{
+    if (!comp) return fmi2Error;
+    if (!state) { logmsg((ModelInstance *)comp, fmi2Error, "fmi2FreeFMUstate: null pointer"); return fmi2Error; }
+    free(*state);
+    *state = NULL;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, size_t *size)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    if (!state || !size) { logmsg(c, fmi2Error, "fmi2SerializedFMUstateSize: null pointer"); return fmi2Error; }
+    *size = sizeof(Snapshot);
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byte serializedState[], size_t size)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    if (!state || !serializedState) { logmsg(c, fmi2Error, "fmi2SerializeFMUstate: null pointer"); return fmi2Error; }
+    if (size < sizeof(Snapshot)) {
+        logmsg(c, fmi2Error, "fmi2SerializeFMUstate: %u bytes given, %u needed", (unsigned)size,
+               (unsigned)sizeof(Snapshot));
+        return fmi2Error;
+    }
+    memcpy(serializedState, state, sizeof(Snapshot));
+    return fmi2OK;
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate *state)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c) return fmi2Error;
+    if (!serializedState || !state) { logmsg(c, fmi2Error, "fmi2DeSerializeFMUstate: null pointer"); return fmi2Error; }
+    if (size != sizeof(Snapshot)) {
+        logmsg(c, fmi2Error, "serialized FMU state of %u bytes: expected %u", (unsigned)size, (unsigned)sizeof(Snapshot));
+        return fmi2Error;
+    }
+    Snapshot tmp;
+    memcpy(&tmp, serializedState, sizeof tmp);
+    if (!snapshot_ok(c, &tmp)) return fmi2Error;
+    Snapshot *snap = (Snapshot *)(*state);
+    if (!snap) {
+        snap = (Snapshot *)malloc(sizeof(Snapshot));
+        if (!snap) { logmsg(c, fmi2Error, "fmi2DeSerializeFMUstate: out of memory"); return fmi2Error; }
+    }
+    *snap = tmp;
+    *state = snap;
+    return fmi2OK;
+}
+
+/* ------------------------------------------------------------------ not provided */
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
+                                        const fmi2Real dvKnown[], fmi2Real dvUnknown[])
+{
+    (void)vUnknown_ref; (void)nUnknown; (void)vKnown_ref; (void)nKnown; (void)dvKnown; (void)dvUnknown;
+    if (comp) logmsg((ModelInstance *)comp, fmi2Error, "directional derivatives are not provided");
+    return fmi2Error;
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[])
+{
+    (void)vr; (void)nvr; (void)order; (void)value;
+    if (comp) logmsg((ModelInstance *)comp, fmi2Error, "input derivatives are not supported");
+    return fmi2Error;
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[])
+{
+    (void)vr; (void)nvr; (void)order; (void)value;
+    if (comp) logmsg((ModelInstance *)comp, fmi2Error, "output derivatives are not provided");
+    return fmi2Error;
+}
+
+fmi2Status fmi2GetStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Status *value)
+{
+    (void)s;
+    if (!comp || !value) return fmi2Error;
+    *value = fmi2OK;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Real *value)
+{
+    ModelInstance *c = (ModelInstance *)comp;
+    if (!c || !value) return fmi2Error;
+    if (s == fmi2LastSuccessfulTime) { *value = c->s.time; return fmi2OK; }
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Integer *value)
+{
+    (void)s;
+    if (!comp || !value) return fmi2Error;
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Boolean *value)
+{
+    (void)s;
+    if (!comp || !value) return fmi2Error;
+    *value = fmi2False;
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component comp, const fmi2StatusKind s, fmi2String *value)
+{
+    (void)s;
+    if (!comp || !value) return fmi2Error;
+    return fmi2Discard;
+}

@@ -1,0 +1,465 @@
+/*
+ * The model of the native FMU: parameters, clamping, input checks, the exact
+ * zero-order-hold step, outputs.  The same semantics as lcvreport.fmu.engine (the
+ * pythonfmu FMU's engine); the numbers come from vehicle_data.h, generated from the
+ * package, so no model equation is written twice.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "linalg.h"
+#include "model.h"
+#include "vehicle.h"
+#include "vehicle_data.h"
+
+static const LcvVehicle *vehicle_of(const ModelInstance *c)
+{
+    return c->s.vehicle >= 0 ? &LCV_VEHICLES[c->s.vehicle] : NULL;
+}
+
+void model_reset(ModelInstance *c)
+{
+    memset(&c->s, 0, sizeof c->s);
+    snprintf(c->s.preset, sizeof c->s.preset, "%s", LCV_DEFAULT_PRESET);
+    c->s.tire_scale = LCV_DEFAULT_TIRE_SCALE;
+    c->s.u_min = LCV_DEFAULT_U_MIN;
+    for (int k = 0; k < LCV_N_INPUTS; ++k) c->s.w[k] = LCV_INPUT_START[k];
+    c->s.last_speed = LCV_INPUT_START[0] > LCV_DEFAULT_U_MIN ? LCV_INPUT_START[0] : LCV_DEFAULT_U_MIN;
+    c->s.phase = PhaseInstantiated;
+    c->s.vehicle = -1;
+    for (int i = 0; i < LCV_N_STEP_CACHE; ++i) c->steps[i].valid = 0;
+    for (int i = 0; i < LCV_N_SPEED_CACHE; ++i) c->speeds[i].valid = 0;
+    c->clock = 0;
+}
+
+/* ------------------------------------------------------------------ parameters */
+static int in_range(double x, double lo, double hi) { return isfinite(x) && x >= lo && x <= hi; }
+
+static int find_vehicle(const char *name)
+{
+#if LCV_HAS_PRESET
+    for (int i = 0; i < LCV_N_VEHICLES; ++i)
+        if (strcmp(name, LCV_VEHICLES[i].name) == 0) return i;
+    return -1;
+#else
+    (void)name;
+    return 0;
+#endif
+}
+
+static void build_input_matrix(ModelInstance *c)
+{
+    const LcvVehicle *v = vehicle_of(c);
+    int n = v->n;
+    memcpy(c->Bw, v->Bw, sizeof(double) * (size_t)n * LCV_N_INPUTS);
+    for (int i = 0; i < n; ++i) c->Bw[i * LCV_N_INPUTS + LCV_IN_DELTA] = c->s.tire_scale * v->Bdelta[i];
+}
+
+int model_exit_initialization(ModelInstance *c)
+{
+    int k = find_vehicle(c->s.preset);
+    if (k < 0) {
+        snprintf(c->msg, sizeof c->msg, "preset: unknown preset '%s'; valid: %s", c->s.preset, LCV_PRESET_LIST);
+        return -1;
+    }
+    if (!in_range(c->s.tire_scale, LCV_TIRE_SCALE_LOW, LCV_TIRE_SCALE_HIGH)) {
+        snprintf(c->msg, sizeof c->msg, "tire_scale must be in [%.4g, %.4g], got %.6g", LCV_TIRE_SCALE_LOW,
+                 LCV_TIRE_SCALE_HIGH, c->s.tire_scale);
+        return -1;
+    }
+    if (!in_range(c->s.u_min, LCV_U_MIN_LOW, LCV_U_MIN_HIGH)) {
+        snprintf(c->msg, sizeof c->msg, "u_min must be in [%.4g, %.4g] m/s, got %.6g", LCV_U_MIN_LOW,
+                 LCV_U_MIN_HIGH, c->s.u_min);
+        return -1;
+    }
+    c->s.vehicle = k;
+    for (int i = 0; i < LCV_MAX_M; ++i) c->s.z[i] = 0.0;
+    c->s.time = 0.0;
+    c->s.clamped = 0;
+    c->s.last_speed = c->s.w[0] > c->s.u_min && c->s.w[0] <= LCV_SPEED_MAX ? c->s.w[0] : c->s.u_min;
+    for (int i = 0; i < LCV_N_STEP_CACHE; ++i) c->steps[i].valid = 0;
+    for (int i = 0; i < LCV_N_SPEED_CACHE; ++i) c->speeds[i].valid = 0;
+    build_input_matrix(c);
+    return 0;
+}
+
+/* ------------------------------------------------------------------ the system at a speed */
+static void system_matrices(const LcvVehicle *v, double u, double scale, double *M, double *S)
+{
+    int nn = v->n * v->n;
+    for (int i = 0; i < nn; ++i) {
+        M[i] = v->M0[i] + u * v->M1[i];
+        S[i] = scale * (v->S0[i] + v->Sinv[i] / u) + v->Skin[i] + u * v->Su[i];
+    }
+}
+
+/* The speed-dependent output maps (A = M^-1 S, Ca, Da Bw), cached per speed. */
+static SpeedEntry *speed_entry(ModelInstance *c, double u)
+{
+    const LcvVehicle *v = vehicle_of(c);
+    SpeedEntry *slot = NULL, *oldest = &c->speeds[0];
+    for (int i = 0; i < LCV_N_SPEED_CACHE; ++i) {
+        SpeedEntry *e = &c->speeds[i];
+        if (e->valid && e->u == u) { e->stamp = ++c->clock; return e; }
+        if (!e->valid) { if (!slot) slot = e; }
+        else if (e->stamp < oldest->stamp) oldest = e;
+    }
+    if (!slot) slot = oldest;
+    int n = v->n, N = v->n_units;
+    /* work: M (n n) | S, then [S | I] solved in place: n x 2n | solve workspace n n + n */
+    double *M = c->work, *SI = M + (size_t)n * n, *ws = SI + 2 * (size_t)n * n;
+    double *S = ws;   /* S is assembled in the solve workspace first, then copied */
+    system_matrices(v, u, c->s.tire_scale, M, S);
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            SI[(size_t)i * 2 * n + j] = S[(size_t)i * n + j];
+            SI[(size_t)i * 2 * n + n + j] = i == j ? 1.0 : 0.0;
+        }
+    slot->valid = 0;
+    if (lcv_solve_scaled(M, n, SI, 2 * n, 2 * n, ws) != 0) return NULL;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) slot->A[(size_t)i * n + j] = SI[(size_t)i * 2 * n + j];
+    /* V = Vq + u Vth; Ca = V A + u R; Da = V M^-1; DaB = Da Bw */
+    double *V = ws, *Da = V + (size_t)N * n;
+    for (int i = 0; i < N * n; ++i) V[i] = v->Vq[i] + u * v->Vth[i];
+    lcv_matmul(V, n, slot->A, n, slot->Ca, n, N, n, n);
+    for (int i = 0; i < N * n; ++i) slot->Ca[i] += u * v->R[i];
+    for (int i = 0; i < N; ++i)
+        for (int j = 0; j < n; ++j) {
+            double s = 0.0;
+            for (int l = 0; l < n; ++l) s += V[(size_t)i * n + l] * SI[(size_t)l * 2 * n + n + j];
+            Da[(size_t)i * n + j] = s;
+        }
+    lcv_matmul(Da, n, c->Bw, LCV_N_INPUTS, slot->DaB, LCV_N_INPUTS, N, n, LCV_N_INPUTS);
+    slot->u = u;
+    slot->eig_state = 0;
+    slot->valid = 1;
+    slot->stamp = ++c->clock;
+    return slot;
+}
+
+static int max_real_eig(ModelInstance *c, double u, double *value)
+{
+    SpeedEntry *e = speed_entry(c, u);
+    if (!e) return -1;
+    if (e->eig_state == 0) {
+        int n = vehicle_of(c)->n;
+        double *a = c->work, *wr = a + (size_t)n * n, *wi = wr + n;
+        memcpy(a, e->A, sizeof(double) * (size_t)n * n);
+        if (lcv_eigenvalues(a, n, wr, wi) != 0) {
+            e->eig_state = -1;
+        } else {
+            double best = wr[0];
+            for (int i = 1; i < n; ++i) if (wr[i] > best) best = wr[i];
+            e->eig = best;
+            e->eig_state = 1;
+        }
+    }
+    if (e->eig_state < 0) return -1;
+    *value = e->eig;
+    return 0;
+}
+
+/* [Ad, Gd Bw] for speed u [m/s] and step h [s], from exp([[A_aug h, G_aug h], [0, 0]]) with
+   A_aug = [[M^-1 S, 0], [e_r1, 0, 0], [e_v1, u, 0]], G_aug = [M^-1; 0] (cached). */
+static const double *step_matrix(ModelInstance *c, double u, double h)
+{
+    const LcvVehicle *v = vehicle_of(c);
+    StepEntry *slot = NULL, *oldest = &c->steps[0];
+    for (int i = 0; i < LCV_N_STEP_CACHE; ++i) {
+        StepEntry *e = &c->steps[i];
+        if (e->valid && e->u == u && e->h == h) { e->stamp = ++c->clock; return e->K; }
+        if (!e->valid) { if (!slot) slot = e; }
+        else if (e->stamp < oldest->stamp) oldest = e;
+    }
+    if (!slot) slot = oldest;
+    int n = v->n, m = n + 2, nb = m + n, ld = m + LCV_N_INPUTS;
+    SpeedEntry *se = speed_entry(c, u);
+    if (!se) return NULL;
+    /* M^-1 again (the speed entry keeps A only): solve M X = I */
+    double *big = c->work, *E = big + (size_t)nb * nb, *Minv = E + (size_t)nb * nb, *ws = Minv + (size_t)n * n;
+    double *M = ws + (size_t)n * n + n;
+    for (int i = 0; i < n * n; ++i) M[i] = v->M0[i] + u * v->M1[i];
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) Minv[(size_t)i * n + j] = i == j ? 1.0 : 0.0;
+    if (lcv_solve_scaled(M, n, Minv, n, n, ws) != 0) return NULL;
+    for (size_t i = 0; i < (size_t)nb * nb; ++i) big[i] = 0.0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            big[(size_t)i * nb + j] = se->A[(size_t)i * n + j] * h;
+            big[(size_t)i * nb + m + j] = Minv[(size_t)i * n + j] * h;
+        }
+    big[(size_t)n * nb + 1] = h;               /* psi1' = r1 */
+    big[(size_t)(n + 1) * nb + 0] = h;         /* Y1' = v1 + u psi1 */
+    big[(size_t)(n + 1) * nb + n] = u * h;
+    slot->valid = 0;
+    if (lcv_expm(big, nb, E, Minv) != 0) return NULL;   /* Minv's storage reused as expm workspace */
+    for (int i = 0; i < m; ++i) {
+        for (int j = 0; j < m; ++j) slot->K[(size_t)i * ld + j] = E[(size_t)i * nb + j];
+        for (int j = 0; j < LCV_N_INPUTS; ++j) {
+            double s = 0.0;
+            for (int l = 0; l < n; ++l) s += E[(size_t)i * nb + m + l] * c->Bw[(size_t)l * LCV_N_INPUTS + j];
+            slot->K[(size_t)i * ld + m + j] = s;
+        }
+    }
+    slot->valid = 1;
+    slot->u = u;
+    slot->h = h;
+    slot->stamp = ++c->clock;
+    return slot->K;
+}
+
+/* ------------------------------------------------------------------ inputs and steps */
+static int check_inputs(ModelInstance *c)
+{
+    for (int k = 0; k < LCV_N_INPUTS; ++k) {
+        double x = c->s.w[k];
+        const char *name = LCV_VARIABLE_NAMES[LCV_FIRST_INPUT + k];
+        if (!isfinite(x)) {
+            snprintf(c->msg, sizeof c->msg, "input %s is not finite (%g); the step is refused and the state is "
+                     "unchanged", name, x);
+            return -1;
+        }
+        double lim = 0.0;
+        switch (LCV_INPUT_KIND[k]) {
+        case LCV_IN_SPEED:
+            if (x > LCV_SPEED_MAX) {
+                snprintf(c->msg, sizeof c->msg, "input u = %.6g m/s is above %.4g m/s, the fastest speed the model "
+                         "is run at; the step is refused and the state is unchanged", x, LCV_SPEED_MAX);
+                return -1;
+            }
+            continue;
+        case LCV_IN_STEER: lim = LCV_STEER_MAX; break;
+        case LCV_IN_FORCE: lim = LCV_FORCE_MAX; break;
+        default: lim = LCV_MOMENT_MAX; break;
+        }
+        if (fabs(x) > lim) {
+            snprintf(c->msg, sizeof c->msg, "input %s = %.6g is outside [%.4g, %.4g]; the step is refused and the "
+                     "state is unchanged", name, x, -lim, lim);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+int model_do_step(ModelInstance *c, double h)
+{
+    if (!(isfinite(h) && h >= LCV_STEP_LOW && h <= LCV_STEP_HIGH)) {
+        snprintf(c->msg, sizeof c->msg, "communication step size must be in [%.4g, %.4g] s, got %.17g; the step "
+                 "is refused", LCV_STEP_LOW, LCV_STEP_HIGH, h);
+        return -1;
+    }
+    if (check_inputs(c) != 0) return -1;
+    const LcvVehicle *v = vehicle_of(c);
+    int m = v->n + 2, ld = m + LCV_N_INPUTS;
+    double u_in = c->s.w[0], u = u_in < c->s.u_min ? c->s.u_min : u_in;
+    int warn = 0, clamped = u_in < c->s.u_min;
+    if (clamped && !c->s.clamped) {
+        snprintf(c->msg, sizeof c->msg, "u = %.6g m/s is below u_min = %.6g m/s; the model runs at u_min until u "
+                 "rises again (the linear model needs a forward speed)", u_in, c->s.u_min);
+        warn = 1;
+    }
+    const double *K = step_matrix(c, u, h);
+    if (!K) {
+        snprintf(c->msg, sizeof c->msg, "the discretization failed at u = %.6g m/s, h = %.6g s (not finite); the "
+                 "step is refused and the state is unchanged", u, h);
+        return -1;
+    }
+    double znew[LCV_MAX_M];
+    for (int i = 0; i < m; ++i) {
+        const double *row = K + (size_t)i * ld;
+        double s = 0.0;
+        for (int j = 0; j < m; ++j) s += row[j] * c->s.z[j];
+        for (int j = 0; j < LCV_N_INPUTS; ++j) s += row[m + j] * c->s.w[j];
+        if (!isfinite(s)) {
+            double e = 0.0;
+            int ok = max_real_eig(c, u, &e) == 0;
+            snprintf(c->msg, sizeof c->msg, "the step to t = %.6g s is refused: its result is not finite (the vehicle "
+                     "is unstable at u = %.6g m/s, max Re(lambda) = %s%.4g 1/s); the state is unchanged",
+                     c->s.time + h, u, ok ? "" : "unknown ", ok ? e : 0.0);
+            return -1;
+        }
+        znew[i] = s;
+    }
+    memcpy(c->s.z, znew, sizeof(double) * (size_t)m);
+    c->s.time += h;
+    c->s.clamped = clamped;
+    c->s.last_speed = u;
+    return warn;
+}
+
+/* ------------------------------------------------------------------ outputs */
+static double output_speed(const ModelInstance *c)
+{
+    double u = c->s.w[0];
+    if (isfinite(u) && u <= LCV_SPEED_MAX) return u < c->s.u_min ? c->s.u_min : u;
+    return c->s.last_speed;
+}
+
+static int compute_outputs(ModelInstance *c, double *out)
+{
+    const LcvVehicle *v = vehicle_of(c);
+    int n = v->n, m = n + 2, N = v->n_units;
+    double theta_sin[LCV_MAX_UNITS];
+    for (int k = 0; k < N - 1; ++k) {
+        double s = 0.0;
+        for (int j = 0; j < m; ++j) s += v->H[(size_t)k * m + j] * c->s.z[j];
+        theta_sin[k] = sin(s);
+    }
+    double u = output_speed(c);
+    SpeedEntry *se = NULL;
+    for (int o = 0; o < LCV_N_OUTPUTS; ++o) {
+        double s = 0.0;
+        switch (LCV_OUTPUT_KIND[o]) {
+        case LCV_OUT_LINEAR:
+            for (int j = 0; j < m; ++j) s += v->C[(size_t)o * m + j] * c->s.z[j];
+            break;
+        case LCV_OUT_LATERAL:
+            for (int k = 0; k < N - 1; ++k) s += v->W[(size_t)o * (N - 1) + k] * theta_sin[k];
+            break;
+        case LCV_OUT_ACCEL: {
+            int i = v->ay_unit[o];
+            if (i < 0) break;
+            if (!se && !(se = speed_entry(c, u))) {
+                snprintf(c->msg, sizeof c->msg, "the lateral accelerations cannot be evaluated at u = %.6g m/s", u);
+                return -1;
+            }
+            for (int j = 0; j < n; ++j) s += se->Ca[(size_t)i * n + j] * c->s.z[j];
+            for (int j = 0; j < LCV_N_INPUTS; ++j) s += se->DaB[(size_t)i * LCV_N_INPUTS + j] * c->s.w[j];
+            break;
+        }
+        default:
+            if (max_real_eig(c, u, &s) != 0) {
+                snprintf(c->msg, sizeof c->msg, "the eigenvalues at u = %.6g m/s did not converge", u);
+                return -1;
+            }
+            break;
+        }
+        if (!isfinite(s)) {
+            snprintf(c->msg, sizeof c->msg, "output %s is not finite", LCV_VARIABLE_NAMES[LCV_FIRST_OUTPUT + o]);
+            return -1;
+        }
+        out[o] = s;
+    }
+    return 0;
+}
+
+int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, double value[])
+{
+    double out[LCV_N_OUTPUTS];
+    int have = 0, status = 0;
+    for (size_t i = 0; i < nvr; ++i) {
+        unsigned r = vr[i];
+        switch (r) {
+        case vr_tire_scale: value[i] = c->s.tire_scale; continue;
+        case vr_u_min: value[i] = c->s.u_min; continue;
+        default: break;
+        }
+        if (r >= LCV_FIRST_INPUT && r < LCV_FIRST_INPUT + LCV_N_INPUTS) {
+            value[i] = c->s.w[r - LCV_FIRST_INPUT];
+        } else if (r >= LCV_FIRST_OUTPUT && r < LCV_FIRST_OUTPUT + LCV_N_OUTPUTS) {
+            value[i] = 0.0;
+            if (c->s.vehicle < 0) continue;                /* before initialization: at rest */
+            if (!have) {
+                if (compute_outputs(c, out) != 0) { status = -1; continue; }
+                have = 1;
+            }
+            value[i] = out[r - LCV_FIRST_OUTPUT];
+        } else {
+            value[i] = 0.0;
+            snprintf(c->msg, sizeof c->msg, "fmi2GetReal: %u is not the value reference of a Real variable", r);
+            status = -1;
+        }
+    }
+    return status;
+}
+
+int model_set_real(ModelInstance *c, fmi2ValueReference vr, double value)
+{
+    switch (vr) {
+    case vr_tire_scale:
+    case vr_u_min:
+        if (!(c->s.phase & (PhaseInstantiated | PhaseInitializationMode))) {
+            snprintf(c->msg, sizeof c->msg, "%s is a fixed parameter: it cannot change after initialization",
+                     LCV_VARIABLE_NAMES[vr]);
+            return -1;
+        }
+        if (vr == vr_tire_scale) c->s.tire_scale = value; else c->s.u_min = value;
+        return 0;
+    default:
+        break;
+    }
+    if (vr >= LCV_FIRST_INPUT && vr < LCV_FIRST_INPUT + LCV_N_INPUTS) {
+        c->s.w[vr - LCV_FIRST_INPUT] = value;
+        return 0;
+    }
+    snprintf(c->msg, sizeof c->msg, "fmi2SetReal: %u is not the value reference of an input or a Real parameter",
+             (unsigned)vr);
+    return -1;
+}
+
+int model_get_string(ModelInstance *c, fmi2ValueReference vr, const char **value)
+{
+#if LCV_HAS_PRESET
+    if (vr == vr_preset) { *value = c->s.preset; return 0; }
+#endif
+    *value = "";
+    snprintf(c->msg, sizeof c->msg, "fmi2GetString: %u is not the value reference of a String variable", (unsigned)vr);
+    return -1;
+}
+
+int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value)
+{
+#if LCV_HAS_PRESET
+    if (vr == vr_preset) {
+        if (!(c->s.phase & (PhaseInstantiated | PhaseInitializationMode))) {
+            snprintf(c->msg, sizeof c->msg, "preset is a fixed parameter: it cannot change after initialization");
+            return -1;
+        }
+        const char *text = value ? value : "";
+        /* a name longer than the buffer is kept truncated: it is no preset, initialization names it */
+        snprintf(c->s.preset, sizeof c->s.preset, "%s", text);
+        return 0;
+    }
+#endif
+    (void)value;
+    snprintf(c->msg, sizeof c->msg, "fmi2SetString: %u is not the value reference of a String variable", (unsigned)vr);
+    return -1;
+}
+
+/* ------------------------------------------------------------------ FMU state */
+int model_check_state(ModelInstance *c, const ModelState *s)
+{
+    if (memchr(s->preset, '\0', sizeof s->preset) == NULL || memchr(s->error, '\0', sizeof s->error) == NULL) {
+        snprintf(c->msg, sizeof c->msg, "the FMU state is refused: its text fields are not terminated");
+        return -1;
+    }
+    int phases = PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError;
+    if (!(s->phase & phases) || (s->phase & ~phases) || s->vehicle < -1 || s->vehicle >= LCV_N_VEHICLES) {
+        snprintf(c->msg, sizeof c->msg, "the FMU state is refused: it was not written by this FMU");
+        return -1;
+    }
+    int finite = isfinite(s->tire_scale) && isfinite(s->u_min) && isfinite(s->time) && isfinite(s->last_speed);
+    for (int i = 0; i < LCV_MAX_M; ++i) finite = finite && isfinite(s->z[i]);
+    for (int k = 0; k < LCV_N_INPUTS; ++k) finite = finite && !isnan(s->w[k]);
+    if (!finite) {
+        snprintf(c->msg, sizeof c->msg, "the FMU state is refused: it holds numbers that are not finite");
+        return -1;
+    }
+    if (s->vehicle >= 0 && (!in_range(s->tire_scale, LCV_TIRE_SCALE_LOW, LCV_TIRE_SCALE_HIGH) ||
+                            !in_range(s->u_min, LCV_U_MIN_LOW, LCV_U_MIN_HIGH))) {
+        snprintf(c->msg, sizeof c->msg, "the FMU state is refused: its parameters are out of range");
+        return -1;
+    }
+    return 0;
+}
+
+void model_state_restored(ModelInstance *c, int same_vehicle)
+{
+    if (!same_vehicle) {
+        for (int i = 0; i < LCV_N_STEP_CACHE; ++i) c->steps[i].valid = 0;
+        for (int i = 0; i < LCV_N_SPEED_CACHE; ++i) c->speeds[i].valid = 0;
+    }
+    if (c->s.vehicle >= 0) build_input_matrix(c);
+}

@@ -1,0 +1,52 @@
+/*
+ * The interface-only twin of model.c, for benchmarks/fmu_step.py: the same FMI API
+ * (fmi2_api.c) and variables, no model -- every step succeeds at once and every output
+ * is 0.  What a host spends per step on an FMU that does nothing.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "model.h"
+
+void model_reset(ModelInstance *c)
+{
+    memset(&c->s, 0, sizeof c->s);
+    snprintf(c->s.preset, sizeof c->s.preset, "%s", LCV_DEFAULT_PRESET);
+    c->s.phase = PhaseInstantiated;
+    c->s.vehicle = -1;
+}
+
+int model_exit_initialization(ModelInstance *c) { c->s.vehicle = 0; return 0; }
+
+int model_do_step(ModelInstance *c, double h) { c->s.time += h; return 0; }
+
+int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, double value[])
+{
+    (void)c; (void)vr;
+    for (size_t i = 0; i < nvr; ++i) value[i] = 0.0;
+    return 0;
+}
+
+int model_set_real(ModelInstance *c, fmi2ValueReference vr, double value)
+{
+    if (vr >= LCV_FIRST_INPUT && vr < LCV_FIRST_INPUT + LCV_N_INPUTS) c->s.w[vr - LCV_FIRST_INPUT] = value;
+    return 0;
+}
+
+int model_get_string(ModelInstance *c, fmi2ValueReference vr, const char **value)
+{
+    (void)vr;
+    *value = c->s.preset;
+    return 0;
+}
+
+int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value)
+{
+    (void)vr;
+    snprintf(c->s.preset, sizeof c->s.preset, "%s", value ? value : "");
+    return 0;
+}
+
+int model_check_state(ModelInstance *c, const ModelState *s) { (void)c; (void)s; return 0; }
+
+void model_state_restored(ModelInstance *c, int same_vehicle) { (void)c; (void)same_vehicle; }

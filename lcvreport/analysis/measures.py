@@ -1,0 +1,445 @@
+r"""The standard yaw-plane performance measures at one speed (SPEC section 8), SI.
+
+* Lateral acceleration of unit i's CG: ``a_i = v_i' + u r_i``.
+* **Least damping ratio**: the smallest ``-Re(lambda)/|lambda|`` over eigenvalues with
+  ``Im(lambda) > 0``, and that mode's damped frequency ``Im(lambda)/2 pi`` [Hz]; None
+  when no mode oscillates.
+* **Critical speed**: the lowest speed in ``(u_min, 200 km/h]`` where the largest real
+  part of the eigenvalues is >= 0, to 0.1 km/h (a 1 km/h scan, then bisection); None
+  when stable throughout.
+* **Rearward amplification, frequency domain**: ``RA(f) = |G_N(j 2 pi f)| / |G_1(j 2 pi f)|``,
+  ``G_i`` the transfer function from the steer angle to ``a_i``.
+* **Rearward amplification, single sine** (SAE J2179 / ISO 14791 style): ``delta(t) =
+  delta0 sin(2 pi f t)`` for ``0 <= t <= 1/f``, then 0, from rest;
+  ``RA = max|a_N| / max|a_1|`` over ``0 .. 1/f + 8 s``, exact (zero-order hold, 1 ms
+  steps, delta sampled at the start of each step), evaluated in closed form over the
+  modes (the same numbers as 10,500 exact steps, in a fraction of the time).
+* **Trimmed straight running**: the steady state of ``M x' = S x + b delta + F`` with
+  ``r1 = 0`` (the driver holds the tractor straight against the residual forces):
+  ``delta_trim`` [rad] and the offtracking [m], the lateral offset (positive toward
+  +y) between the path of the rearmost axle of the last unit and the path of the
+  frontmost steered axle (frontmost axle of unit 1 if none is steered), to first
+  order: every point then moves with velocity (u, v1) in the tractor frame.
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> from lcvreport.units import kph_to_mps
+>>> m = measure_set(load_preset("aucnat"), kph_to_mps(88.0), load_units=["trailer2", "trailer3"])
+>>> sorted(m.to_dict())
+['ay_gain_per_unit', 'critical_speed_kph', 'least_damped_frequency_hz', 'least_damping_ratio', 'ra_frequency', 'ra_single_sine', 'speed_mps', 'trim']
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.builder import check_speed, check_tire_scale, system_coefficients
+from ..model.loads import load_vector, one_percent_rule
+from ..model.vehicle import Vehicle
+from ..ranges import RANGES
+from ..units import kph_to_mps, mps_to_kph
+from .geometry import point_lateral_map, point_longitudinal
+from .modes import eigenvalues
+
+#: the frequency of the RA measures [Hz]
+RA_FREQUENCY_HZ = 0.4
+#: upper end of the critical-speed search [km/h]
+CRITICAL_SPEED_MAX_KPH = 200.0
+#: lower end of the critical-speed search: the FMUs' default u_min (5 mph) [m/s]
+U_MIN_DEFAULT_MPS = 2.2352
+#: resolution of the critical speed [km/h]
+CRITICAL_SPEED_RESOLUTION_KPH = 0.1
+#: single sine: step [s], time after the sine [s], default amplitude [rad]
+SINGLE_SINE_STEP_S = 1e-3
+SINGLE_SINE_TAIL_S = 8.0
+SINGLE_SINE_DELTA0_RAD = 0.01
+
+
+def _freq(f_hz):
+    f = np.asarray(f_hz, dtype=float)
+    RANGES["frequency"].check(float(f.min()) if f.size else 0.0, "frequency")
+    RANGES["frequency"].check(float(f.max()) if f.size else 0.0, "frequency")
+    return f
+
+
+def steer_to_acceleration(vehicle: Vehicle, speed_mps: float, f_hz, tire_scale: float = 1.0) -> np.ndarray:
+    """``G_i(j 2 pi f)``: complex gain from the steer angle to the lateral acceleration of
+    every unit's CG [m/s^2 per rad], shape (..., N) for frequencies of shape (...).
+
+    Computed from ``x = (j w M - S)^-1 b_delta`` and ``a = (j w V + u R) x``, with no
+    state-space conversion (the state-space form of :mod:`.statespace` is tested
+    against it).
+    """
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    f = _freq(f_hz)
+    co = system_coefficients(vehicle)
+    M, S, b = co.M(speed_mps), co.S(speed_mps, tire_scale), co.B_delta(tire_scale)
+    V, R = co.velocity_map(speed_mps), co.yaw_rate_map()
+    w = 2 * np.pi * f[..., None, None]
+    x = np.linalg.solve(1j * w * M - S, np.broadcast_to(b, f.shape + b.shape)[..., None])[..., 0]
+    return x @ V.T * (1j * 2 * np.pi * f[..., None]) + speed_mps * (x @ R.T)
+
+
+def rearward_amplification(vehicle: Vehicle, speed_mps: float, f_hz=RA_FREQUENCY_HZ, tire_scale: float = 1.0):
+    """``RA(f) = |G_N| / |G_1|`` [-] at one or many frequencies [Hz]."""
+    G = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
+    ra = G[..., -1] / G[..., 0]
+    return float(ra) if np.ndim(ra) == 0 else ra
+
+
+def least_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> tuple[float | None, float | None]:
+    """(least damping ratio [-], its damped frequency [Hz]) over the oscillatory modes; (None, None) if none."""
+    lam = eigenvalues(vehicle, speed_mps, tire_scale)
+    osc = lam[lam.imag > 1e-12 * max(np.abs(lam).max(), 1.0)]
+    if osc.size == 0:
+        return None, None
+    zeta = -osc.real / np.abs(osc)
+    k = int(np.argmin(zeta))
+    return float(zeta[k]), float(osc[k].imag / (2 * np.pi))
+
+
+def critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: float = U_MIN_DEFAULT_MPS,
+                   u_max_kph: float = CRITICAL_SPEED_MAX_KPH) -> float | None:
+    """Lowest speed [km/h] in ``(u_min, u_max]`` where ``max Re(lambda) >= 0``, to 0.1 km/h; None if stable.
+
+    A scan at 1 km/h steps finds the first unstable speed, bisection narrows it to
+    0.01 km/h, the result is rounded to 0.1 km/h.  An instability band narrower than
+    1 km/h can be missed by the scan (none of the vehicles here has one).
+    """
+    check_tire_scale(tire_scale)
+    lo_kph = mps_to_kph(RANGES["u_min"].check(u_min_mps, "u_min"))
+    n = int(math.ceil(u_max_kph - lo_kph)) + 1
+    grid = np.linspace(lo_kph, u_max_kph, max(n, 2))
+
+    def unstable(v_kph):
+        return eigenvalues(vehicle, kph_to_mps(np.asarray(v_kph)), tire_scale).real.max(axis=-1) >= 0.0
+
+    flags = unstable(grid)
+    if not flags.any():
+        return None
+    i = int(np.argmax(flags))
+    if i == 0:
+        return round(float(grid[0]), 1)
+    lo, hi = float(grid[i - 1]), float(grid[i])
+    while hi - lo > 0.01:
+        mid = 0.5 * (lo + hi)
+        if unstable(mid):
+            hi = mid
+        else:
+            lo = mid
+    return round(0.5 * (lo + hi), 1)
+
+
+@dataclass(frozen=True)
+class SingleSine:
+    """A single-sine steer manoeuvre and the lateral accelerations it produces.
+
+    Attributes
+    ----------
+    time : numpy.ndarray, shape (K,)
+        [s]
+    delta : numpy.ndarray, shape (K,)
+        Steer angle held from each sample [rad].
+    ay : numpy.ndarray, shape (K, N)
+        Lateral acceleration of every unit's CG [m/s^2].
+    frequency_hz, delta0_rad, speed_mps : float
+    vehicle : Vehicle
+    """
+
+    time: np.ndarray
+    delta: np.ndarray
+    ay: np.ndarray
+    frequency_hz: float
+    delta0_rad: float
+    speed_mps: float
+    vehicle: Vehicle = field(repr=False, default=None)
+
+    @property
+    def rearward_amplification(self) -> float:
+        """max|a_N| / max|a_1| [-]."""
+        peaks = np.abs(self.ay).max(axis=0)
+        return float(peaks[-1] / peaks[0])
+
+    @property
+    def peaks(self) -> np.ndarray:
+        """max|a_i| per unit [m/s^2]."""
+        return np.abs(self.ay).max(axis=0)
+
+    def plot(self, ax=None):
+        """Time histories of every unit's a_i (a :class:`matplotlib.figure.Figure`)."""
+        from ..report.plotting import plot_single_sine
+        return plot_single_sine(self, ax=ax)
+
+
+def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_HZ,
+                delta0_rad: float = SINGLE_SINE_DELTA0_RAD, tire_scale: float = 1.0,
+                step_s: float = SINGLE_SINE_STEP_S, tail_s: float = SINGLE_SINE_TAIL_S) -> SingleSine:
+    """The single-sine manoeuvre from rest, exact for the sampled steer (zero-order hold).
+
+    The response is evaluated in closed form over the modes of ``A = M^-1 S``: with
+    ``mu = exp(lambda h)`` and ``z = exp(i 2 pi f h)``, the modal response to the
+    sampled sine is ``sum_j mu^(k-1-j) z^j = (z^k - mu^k)/(z - mu)``, and after the sine
+    ``xi_k = mu^(k-K) xi_K``.  Equal to stepping the exact discretization (tested), but
+    vectorized.  Falls back to stepping if the eigenvectors are ill-conditioned.
+    """
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    f = float(_freq(f_hz))
+    RANGES["steer_angle"].check(delta0_rad, "delta0")
+    co = system_coefficients(vehicle)
+    A, G = co.state_derivative_maps(speed_mps, tire_scale)
+    bd = G @ co.B_delta(tire_scale)
+    Ca, Da = co.acceleration_maps(speed_mps, tire_scale)
+    da = Da @ co.B_delta(tire_scale)
+    h = float(step_s)
+    n_sine = int(round(1.0 / (f * h)))
+    n_total = int(round((1.0 / f + tail_s) / h))
+    k = np.arange(n_total + 1)
+    t = k * h
+    delta = np.where(k < n_sine, delta0_rad * np.sin(2 * np.pi * f * t), 0.0)
+    lam, V = np.linalg.eig(A)
+    theta = 2 * np.pi * f * h
+    zc = np.exp(1j * theta)
+    if np.linalg.cond(V) < 1e8 and np.all(np.abs(zc - np.exp(lam * h)) > 1e-9) and np.all(lam != 0):
+        beta = np.linalg.solve(V, bd)
+        mu = np.exp(lam * h)
+        gamma = beta * (mu - 1.0) / lam
+        ks = k[:n_sine + 1, None]
+        mu_k = np.exp(lam[None, :] * h * ks)
+        s_plus = (np.exp(1j * theta * ks) - mu_k) / (zc - mu)
+        s_minus = (np.exp(-1j * theta * ks) - mu_k) / (np.conj(zc) - mu)
+        xi_sine = gamma * delta0_rad * (s_plus - s_minus) / 2j           # k = 0..n_sine
+        after = k[n_sine + 1:, None] - n_sine
+        xi_after = xi_sine[-1] * np.exp(lam[None, :] * h * after)
+        xi = np.vstack([xi_sine, xi_after])
+        x = (xi @ V.T).real
+    else:  # pragma: no cover - defective or resonant: step the exact discretization
+        from .discretize import augmented_state_matrix, discretize
+        Aa, Ga = augmented_state_matrix(co, speed_mps, tire_scale)
+        Ad, Gd = discretize(Aa, Ga, h)
+        n = vehicle.n_states
+        x = np.zeros((k.size, n))
+        z = np.zeros(n + 2)
+        b = Gd @ co.B_delta(tire_scale)
+        for i in range(k.size - 1):
+            z = Ad @ z + b * delta[i]
+            x[i + 1] = z[:n]
+    ay = x @ Ca.T + delta[:, None] * da
+    return SingleSine(t, delta, ay, f, float(delta0_rad), float(speed_mps), vehicle)
+
+
+@dataclass(frozen=True)
+class Trim:
+    """Trimmed straight running under residual loads.
+
+    Attributes
+    ----------
+    delta_rad : float
+        Steer angle that holds the tractor straight (r1 = 0) [rad].
+    offtracking_m : float
+        Lateral offset of the rearmost axle's path from the steered axle's path [m], +y positive.
+    state : numpy.ndarray, shape (2N,)
+        The trimmed state (v1 m/s, r = 0, theta rad).
+    """
+
+    delta_rad: float
+    offtracking_m: float
+    state: np.ndarray
+
+
+def reference_points(vehicle: Vehicle) -> tuple[tuple[int, float], tuple[int, float]]:
+    """((unit, x) of the frontmost steered axle (or frontmost axle of unit 1),
+    (unit, x) of the rearmost axle of the last unit), 0-based units, x [m]."""
+    first = vehicle.steered_axles or vehicle.units[0].axles
+    q = max(first, key=lambda a: a.x_m)
+    last = vehicle.n_units - 1
+    return (0, q.x_m), (last, vehicle.units[last].rearmost_axle.x_m)
+
+
+def trim(vehicle: Vehicle, speed_mps: float, F: np.ndarray, tire_scale: float = 1.0) -> Trim:
+    """Trimmed straight running under a constant generalized force F (SI).
+
+    Solves ``S x + b delta + F = 0`` with ``r1 = 0`` for ``x`` and ``delta``.
+    """
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    co = system_coefficients(vehicle)
+    S, b = co.S(speed_mps, tire_scale), co.B_delta(tire_scale)
+    n = vehicle.n_states
+    K = np.zeros((n + 1, n + 1))
+    K[:n, :n] = S
+    K[:n, n] = b
+    K[n, 1] = 1.0                       # r1 = 0
+    rhs = np.concatenate([-np.asarray(F, dtype=float), [0.0]])
+    sol = np.linalg.solve(K, rhs)
+    x, delta = sol[:n], float(sol[n])
+    (uq, xq), (up, xp) = reference_points(vehicle)
+    nu = vehicle.n_units
+    Theta = np.cumsum(x[nu + 1:])
+    lateral = lambda unit, xx: float(point_lateral_map(vehicle, unit, xx)[2:] @ Theta)  # noqa: E731 (psi1 = Y1 = 0)
+    dX = point_longitudinal(vehicle, up, xp) - point_longitudinal(vehicle, uq, xq)
+    offtracking = lateral(up, xp) - lateral(uq, xq) - dX * x[0] / speed_mps
+    return Trim(delta, float(offtracking), x)
+
+
+@dataclass(frozen=True)
+class SpeedSweep:
+    """Eigenvalues over a range of speeds (root locus) with the least damping and the stability margin.
+
+    Attributes
+    ----------
+    speeds_kph : numpy.ndarray, shape (K,)
+    eigenvalues : numpy.ndarray, shape (K, 2N)
+        [1/s], mode order.
+    critical_speed_kph : float or None
+    """
+
+    speeds_kph: np.ndarray
+    eigenvalues: np.ndarray
+    critical_speed_kph: float | None
+
+    @property
+    def least_damping_ratio(self) -> np.ndarray:
+        """Least damping ratio over the oscillatory modes per speed [-] (NaN where none oscillates)."""
+        lam = self.eigenvalues
+        osc = lam.imag > 1e-12 * np.maximum(np.abs(lam).max(axis=-1, keepdims=True), 1.0)
+        zeta = np.where(osc, -lam.real / np.where(np.abs(lam) > 0, np.abs(lam), 1.0), np.inf)
+        out = zeta.min(axis=-1)
+        return np.where(np.isfinite(out), out, np.nan)
+
+    @property
+    def max_real(self) -> np.ndarray:
+        """Largest real part per speed [1/s]."""
+        return self.eigenvalues.real.max(axis=-1)
+
+
+def speed_sweep(vehicle: Vehicle, speeds_kph, tire_scale: float = 1.0) -> SpeedSweep:
+    """Eigenvalues at every speed [km/h] (batched) and the critical speed."""
+    v = np.asarray(speeds_kph, dtype=float)
+    return SpeedSweep(v, eigenvalues(vehicle, kph_to_mps(v), tire_scale), critical_speed(vehicle, tire_scale))
+
+
+@dataclass(frozen=True)
+class AxleSensitivity:
+    """Trimmed straight running per unit residual load on one axle.
+
+    Attributes
+    ----------
+    axle, unit : str
+    offtracking_per_P_m_per_kN, offtracking_per_T_m_per_kNm : float
+        Trimmed offtracking [m] per kN of P (along +y) and per kN*m of T (about +z).
+    delta_per_P_rad_per_kN, delta_per_T_rad_per_kNm : float
+        Trim steer angle [rad] per kN of P and per kN*m of T.
+    """
+
+    axle: str
+    unit: str
+    offtracking_per_P_m_per_kN: float
+    offtracking_per_T_m_per_kNm: float
+    delta_per_P_rad_per_kN: float
+    delta_per_T_rad_per_kNm: float
+
+    @property
+    def largest_m(self) -> float:
+        """The larger |offtracking| of 1 kN of P and 1 kN*m of T [m] (the ranking key)."""
+        return max(abs(self.offtracking_per_P_m_per_kN), abs(self.offtracking_per_T_m_per_kNm))
+
+
+def conicity_sensitivity(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> list[AxleSensitivity]:
+    """Trimmed offtracking and trim steer per unit P and T on each axle, ranked by |offtracking|, largest first."""
+    co = system_coefficients(vehicle)
+    out = []
+    for col, (i, ax) in enumerate(zip(vehicle.axle_units, vehicle.axles)):
+        tp = trim(vehicle, speed_mps, co.B_P[:, col] * 1e3, tire_scale)
+        tt = trim(vehicle, speed_mps, co.B_T[:, col] * 1e3, tire_scale)
+        out.append(AxleSensitivity(ax.name, vehicle.units[i].name, tp.offtracking_m, tt.offtracking_m,
+                                   tp.delta_rad, tt.delta_rad))
+    return sorted(out, key=lambda a: a.largest_m, reverse=True)
+
+
+@dataclass(frozen=True)
+class MeasureSet:
+    """The measures of SPEC section 8 for one vehicle at one speed.
+
+    ``to_dict()`` gives the JSON of ``lcv measures`` (keys fixed by the SPEC).
+    """
+
+    vehicle: Vehicle
+    speed_mps: float
+    tire_scale: float
+    least_damping_ratio: float | None
+    least_damped_frequency_hz: float | None
+    critical_speed_kph: float | None
+    ra_frequency: float
+    ra_single_sine: float
+    ay_gain_per_unit: list[float]
+    trim: Trim | None = None
+    load_units: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict:
+        """The SPEC section 8 JSON document."""
+        doc = {"speed_mps": self.speed_mps, "least_damping_ratio": self.least_damping_ratio,
+               "least_damped_frequency_hz": self.least_damped_frequency_hz,
+               "critical_speed_kph": self.critical_speed_kph, "ra_frequency": self.ra_frequency,
+               "ra_single_sine": self.ra_single_sine, "ay_gain_per_unit": list(self.ay_gain_per_unit)}
+        if self.trim is not None:
+            doc["trim"] = {"delta_rad": self.trim.delta_rad, "offtracking_m": self.trim.offtracking_m}
+        return doc
+
+    def rows(self) -> list[dict]:
+        """The measures as table rows (name, value, unit, definition)."""
+        def num(v):
+            return "none" if v is None else v
+        rows = [{"measure": "speed", "value": self.speed_mps, "unit": "m/s",
+                 "note": f"{mps_to_kph(self.speed_mps):.1f} km/h"},
+                {"measure": "least damping ratio", "value": num(self.least_damping_ratio), "unit": "-",
+                 "note": "min -Re/|lambda| over oscillatory modes"},
+                {"measure": "least damped frequency", "value": num(self.least_damped_frequency_hz), "unit": "Hz",
+                 "note": "Im(lambda)/2 pi of that mode"},
+                {"measure": "critical speed", "value": num(self.critical_speed_kph), "unit": "km/h",
+                 "note": "lowest unstable speed up to 200 km/h (none: stable)"},
+                {"measure": "rearward amplification, 0.4 Hz", "value": self.ra_frequency, "unit": "-",
+                 "note": "|G_N| / |G_1|, frequency domain"},
+                {"measure": "rearward amplification, single sine", "value": self.ra_single_sine, "unit": "-",
+                 "note": "max|a_N| / max|a_1|, 0.4 Hz single sine"}]
+        for name, g in zip(self.vehicle.unit_names, self.ay_gain_per_unit):
+            rows.append({"measure": f"lateral acceleration gain, {name}", "value": g, "unit": "m/s^2/rad",
+                         "note": "|G_i(j 2 pi 0.4 Hz)|"})
+        if self.trim is not None:
+            rows.append({"measure": "trim steer angle", "value": self.trim.delta_rad, "unit": "rad",
+                         "note": f"1 % rule on {', '.join(self.load_units)}"})
+            rows.append({"measure": "trimmed offtracking", "value": self.trim.offtracking_m, "unit": "m",
+                         "note": "rearmost axle path - steered axle path, +y"})
+        return rows
+
+
+def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, load_units=None,
+                f_hz: float = RA_FREQUENCY_HZ) -> MeasureSet:
+    """Every SPEC section 8 measure of ``vehicle`` at ``speed_mps`` [m/s].
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    speed_mps : float
+    tire_scale : float
+    load_units : list of str, optional
+        Units carrying the 1 % rule (P along +y, T about +z) for the trim; no trim if None.
+    f_hz : float
+        Frequency of the RA measures and gains [Hz].
+    """
+    zeta, f_zeta = least_damping(vehicle, speed_mps, tire_scale)
+    gains = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
+    ss = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale)
+    tr = None
+    units = ()
+    if load_units:
+        units = tuple(load_units)
+        F = load_vector(vehicle, one_percent_rule(vehicle, list(units)))
+        tr = trim(vehicle, speed_mps, F, tire_scale)
+    return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
+                      critical_speed(vehicle, tire_scale), float(gains[-1] / gains[0]), ss.rearward_amplification,
+                      [float(g) for g in gains], tr, units)

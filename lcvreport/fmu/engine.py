@@ -1,0 +1,355 @@
+"""The co-simulation engine behind the pythonfmu FMUs (SPEC sections 5 and 9), SI, numpy only.
+
+:class:`LCVEngine` holds one vehicle, its state ``z = [x, psi1, Y1]`` and caches of
+exact zero-order-hold discretizations keyed by (speed, step size) and of the
+speed-dependent output maps.  It addresses inputs and outputs through the interface
+table (:mod:`lcvreport.fmu.interface`): the slave in ``fmu_src/LCV.py`` only maps FMI
+calls onto it.  The C FMU implements the same semantics on data generated from the
+same table.  Runs inside the FMU's embedded interpreter, so it imports numpy and
+the numpy-only model core, never scipy.
+
+Semantics (both FMUs):
+
+* inputs are held over a step; ``u`` below ``u_min`` runs at ``u_min`` with one
+  warning each time it enters that range; a non-finite input, an input outside
+  :data:`lcvreport.ranges.RANGES` or a bad step size refuses the step
+  (:class:`CosimError`, the state is kept);
+* a step whose result is not finite is refused with the state kept;
+* outputs: the state's linear functions, the rear offsets (eq. 4.42-4.46, with the
+  sine), ``ay_i`` at the current state and inputs, ``max_real_eig`` at the current
+  (clamped) input speed; units a preset lacks give 0.
+
+Examples
+--------
+>>> from lcvreport.fmu.interface import preset_interface
+>>> e = LCVEngine(preset_interface(), preset="tractor_semitrailer")
+>>> w = e.start_inputs()
+>>> w[e.input_index["P21"]] = 1000.0
+>>> e.step(0.01, w) is None
+True
+"""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from ..analysis.discretize import augmented_state_matrix
+from ..analysis.geometry import point_lateral_map, rear_end_weights
+from ..model.builder import system_coefficients
+from ..ranges import RANGES, RangeError
+from ..util.cache import LRUCache
+from ..util.numerics import expm
+from .interface import Interface
+
+
+class CosimError(ValueError):
+    """A bad parameter, input or call; ``variable`` names it."""
+
+    def __init__(self, variable: str, message: str):
+        super().__init__(message)
+        self.variable = variable
+
+
+#: magic prefix of a serialized engine state
+STATE_MAGIC = "lcv-fmu-state/1"
+
+
+class LCVEngine:
+    """Exact zero-order-hold stepping of one vehicle through an FMU interface (SI).
+
+    Parameters
+    ----------
+    interface : Interface
+    preset : str, optional
+        In preset mode, the preset to run.
+    tire_scale : float
+        Factor on every tire coefficient [-].
+    u_min : float
+        Lowest speed the model is run at [m/s].
+    cache_size : int
+        Number of (speed, step) discretizations kept.
+
+    Raises
+    ------
+    CosimError
+        For a bad parameter (the message names it and its range).
+    """
+
+    def __init__(self, interface: Interface, preset: str | None = None, tire_scale: float = 1.0,
+                 u_min: float = 2.2352, cache_size: int = 128):
+        self.interface = interface
+        try:
+            vehicle = interface.vehicle(preset)
+        except KeyError as exc:
+            raise CosimError("preset", str(exc.args[0])) from None
+        for name, value in (("tire_scale", tire_scale), ("u_min", u_min)):
+            try:
+                RANGES[name].check(value, name)
+            except RangeError as exc:
+                raise CosimError(name, str(exc)) from None
+        self.preset = preset
+        self.vehicle = vehicle
+        self.tire_scale = float(tire_scale)
+        self.u_min = float(u_min)
+        self.co = system_coefficients(vehicle)
+        self.n = vehicle.n_states
+        self.m = self.n + 2
+        self.input_names = tuple(v.name for v in interface.inputs)
+        self.input_index = {name: k for k, name in enumerate(self.input_names)}
+        self.output_names = tuple(v.name for v in interface.outputs)
+        self._build_maps()
+        self._steps = LRUCache(cache_size)
+        self._speeds = LRUCache(1024)
+        self.reset()
+
+    # ------------------------------------------------------------------ set-up
+    def _build_maps(self) -> None:
+        """Input matrix and output maps from the interface table."""
+        v, co, n, m = self.vehicle, self.co, self.n, self.m
+        axles = v.axle_names
+        nu = v.n_units
+        self._Bw = np.zeros((n, len(self.input_names)))
+        self._ranges = []
+        for k, var in enumerate(self.interface.inputs):
+            kind = var.source[0]
+            if kind == "steer":
+                self._Bw[:, k] = co.B_delta(self.tire_scale)
+                self._ranges.append(RANGES["steer_angle"])
+            elif kind in ("P", "T") and var.source[1] in axles:
+                col = axles.index(var.source[1])
+                self._Bw[:, k] = (co.B_P if kind == "P" else co.B_T)[:, col]
+                self._ranges.append(RANGES["residual_force" if kind == "P" else "residual_moment"])
+            elif kind in ("P", "T"):  # an axle the preset lacks: ignored
+                self._ranges.append(RANGES["residual_force" if kind == "P" else "residual_moment"])
+            else:
+                self._ranges.append(None)
+        self._range_lo = np.array([-np.inf if r is None else r.low for r in self._ranges])
+        self._range_hi = np.array([np.inf if r is None else r.high for r in self._ranges])
+        n_out = len(self.output_names)
+        self._C = np.zeros((n_out, m))           # linear outputs of z
+        self._W = np.zeros((n_out, nu - 1))      # y outputs: W sin(Theta)
+        self._ay_unit = np.full(n_out, -1)       # unit index of ay outputs
+        self._eig_out = -1
+        cum = np.zeros((nu - 1, m))              # Theta = cum z
+        for k in range(nu - 1):
+            cum[k, nu + 1:nu + 2 + k] = 1.0
+        self._H = cum
+        W_all = rear_end_weights(v)
+        c = point_lateral_map(v, nu - 1, v.rear_end_x_m(nu - 1))     # Y_rear = c . [psi1, Y1, Theta]
+        rear_row = c[2:] @ cum
+        rear_row[n] += c[0]
+        rear_row[n + 1] += c[1]
+        states = v.state_names
+        for o, var in enumerate(self.interface.outputs):
+            kind = var.source[0]
+            if kind == "state" and var.source[1] in states:
+                self._C[o, states.index(var.source[1])] = 1.0
+            elif kind == "psi1":
+                self._C[o, n] = 1.0
+            elif kind == "Y1":
+                self._C[o, n + 1] = 1.0
+            elif kind == "Y_rear":
+                self._C[o] = rear_row
+            elif kind == "y" and var.source[1] <= nu:
+                self._W[o] = W_all[var.source[1] - 2]
+            elif kind == "ay" and var.source[1] <= nu:
+                self._ay_unit[o] = var.source[1] - 1
+            elif kind == "max_real_eig":
+                self._eig_out = o
+        self._has_y = bool(np.any(self._W))
+
+    def maps(self) -> dict:
+        """The engine's input and output maps (what the C FMU's generated data holds):
+        ``Bw`` (2N x inputs, steer column at tire scale 1), ``C`` (outputs x 2N+2),
+        ``H`` (N-1 x 2N+2), ``W`` (outputs x N-1), ``ay_unit`` (outputs; -1: not an ay),
+        ``eig_out`` (index of max_real_eig or -1)."""
+        Bw = self._Bw.copy()
+        if self.tire_scale != 1.0:
+            for k, var in enumerate(self.interface.inputs):
+                if var.source[0] == "steer":
+                    Bw[:, k] = self.co.B_delta(1.0)
+        return {"Bw": Bw, "C": self._C.copy(), "H": self._H.copy(), "W": self._W.copy(),
+                "ay_unit": self._ay_unit.copy(), "eig_out": self._eig_out}
+
+    def start_inputs(self) -> np.ndarray:
+        """The inputs' start values (interface order), SI."""
+        return np.array([float(v.start) for v in self.interface.inputs])
+
+    def reset(self) -> None:
+        """Back to rest at time 0 (keeps the caches)."""
+        self.z = np.zeros(self.m)
+        self.time = 0.0
+        self.clamped = False
+        self.last_speed_mps = self.effective_speed(float(self.interface.by_name["u"].start))
+
+    # ------------------------------------------------------------------ checks
+    def effective_speed(self, u: float) -> float:
+        """The speed the model runs at for an input ``u`` [m/s] (clamped to u_min)."""
+        return max(u, self.u_min)
+
+    def check_inputs(self, w: np.ndarray) -> None:
+        """Raise :class:`CosimError` naming the first input that is not finite or out of range."""
+        w = np.asarray(w, dtype=float)
+        ok = np.isfinite(w) & (w >= self._range_lo) & (w <= self._range_hi)
+        u = w[0]
+        speed_ok = math.isfinite(u) and u <= RANGES["speed"].high
+        if ok.all() and speed_ok:
+            return
+        for k, name in enumerate(self.input_names):
+            val = w[k]
+            if not math.isfinite(val):
+                raise CosimError(name, f"input {name} is not finite ({val!r}); the step is refused and the state "
+                                       "is unchanged")
+            if k == 0 and not speed_ok:
+                raise CosimError(name, f"input u = {val:.6g} m/s is above {RANGES['speed'].high:g} m/s, the fastest "
+                                       "speed the model is run at; the step is refused and the state is unchanged")
+            if not ok[k]:
+                r = self._ranges[k]
+                raise CosimError(name, f"input {name} = {val:.6g} is outside {r.text()}; the step is refused and "
+                                       "the state is unchanged")
+
+    # ------------------------------------------------------------------ caches
+    def _step_matrix(self, u: float, h: float) -> np.ndarray:
+        """``[Ad, Gd Bw]``: the new z from ``[z, w]`` (cached per speed and step)."""
+        def compute():
+            A, G = augmented_state_matrix(self.co, u, self.tire_scale)
+            nb = self.m + self.n
+            big = np.zeros((nb, nb))
+            big[:self.m, :self.m] = A * h
+            big[:self.m, self.m:] = G * h
+            E = expm(big)
+            K = np.hstack([E[:self.m, :self.m], E[:self.m, self.m:] @ self._Bw])
+            K.setflags(write=False)
+            return K
+        return self._steps.get((u, h), compute)
+
+    def _speed_maps(self, u: float) -> dict:
+        """Output maps that depend on the speed: ay (Ca, Da Bw); max_real_eig (lazy)."""
+        def compute():
+            Ca, Da = self.co.acceleration_maps(u, self.tire_scale)
+            return {"Ca": Ca, "DaB": Da @ self._Bw, "eig": None}
+        return self._speeds.get(u, compute)
+
+    def max_real_eig(self, u: float) -> float:
+        """Largest real part of the eigenvalues at speed ``u`` [m/s] (cached)."""
+        maps = self._speed_maps(u)
+        if maps["eig"] is None:
+            A, _ = self.co.state_derivative_maps(u, self.tire_scale)
+            maps["eig"] = float(np.linalg.eigvals(A).real.max())
+        return maps["eig"]
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, h: float, w) -> str | None:
+        """Advance by ``h`` [s] with the SI inputs ``w`` (interface order) held.
+
+        Returns
+        -------
+        str or None
+            A warning to log (speed clamped), else None.
+
+        Raises
+        ------
+        CosimError
+            A bad step size or input, or a step whose result is not finite; the state
+            is left unchanged.
+        """
+        r = RANGES["step_size"]
+        if not (isinstance(h, float) and math.isfinite(h) and r.low <= h <= r.high):
+            raise CosimError("communicationStepSize", f"communication step size must be in {r.text()}, got {h!r}; "
+                                                      "the step is refused")
+        w = np.asarray(w, dtype=float)
+        self.check_inputs(w)
+        u_in = float(w[0])
+        u = self.effective_speed(u_in)
+        warning = None
+        if u_in < self.u_min:
+            if not self.clamped:
+                warning = (f"u = {u_in:.6g} m/s is below u_min = {self.u_min:.6g} m/s; the model runs at u_min "
+                           "until u rises again (the linear model needs a forward speed)")
+            clamped = True
+        else:
+            clamped = False
+        K = self._step_matrix(u, h)
+        z_new = K[:, :self.m] @ self.z + K[:, self.m:] @ w
+        if not np.all(np.isfinite(z_new)):
+            raise CosimError("state", f"the step to t = {self.time + h:.6g} s is refused: its result is not finite "
+                                      f"(the vehicle is unstable at u = {u:.6g} m/s, max Re(lambda) = "
+                                      f"{self.max_real_eig(u):.4g} 1/s); the state is unchanged")
+        self.z = z_new
+        self.time += h
+        self.clamped = clamped
+        self.last_speed_mps = u
+        return warning
+
+    # ------------------------------------------------------------------ outputs
+    def output_speed(self, w) -> float:
+        """The speed the feedthrough outputs are evaluated at: the input u clamped to
+        u_min, or the last speed stepped with when u is not a valid speed."""
+        u = float(w[0])
+        if math.isfinite(u) and u <= RANGES["speed"].high:
+            return self.effective_speed(u)
+        return self.last_speed_mps
+
+    def outputs(self, w) -> np.ndarray:
+        """Every output (interface order), SI, at the current state and inputs ``w``."""
+        w = np.asarray(w, dtype=float)
+        out = self._C @ self.z
+        if self._has_y:
+            out += self._W @ np.sin(self._H @ self.z)
+        sel = self._ay_unit >= 0
+        if sel.any() or self._eig_out >= 0:
+            u = self.output_speed(w)
+            if sel.any():
+                wf = np.where(np.isfinite(w), w, 0.0)
+                maps = self._speed_maps(u)
+                ay = maps["Ca"] @ self.z[:self.n] + maps["DaB"] @ wf
+                out[sel] = ay[self._ay_unit[sel]]
+            if self._eig_out >= 0:
+                out[self._eig_out] = self.max_real_eig(u)
+        return out
+
+    # ------------------------------------------------------------------ FMU state
+    def get_state(self) -> dict:
+        """JSON-serializable snapshot of everything that evolves (floats round-trip exactly)."""
+        return {"z": self.z.tolist(), "time": self.time, "clamped": self.clamped,
+                "last_speed_mps": self.last_speed_mps}
+
+    def set_state(self, state: dict) -> None:
+        """Restore a snapshot of :meth:`get_state`.
+
+        Raises
+        ------
+        CosimError
+            A snapshot of another size or with non-finite numbers.
+        """
+        try:
+            z = np.array(state["z"], dtype=float)
+            t = float(state["time"])
+            clamped = bool(state["clamped"])
+            last = float(state["last_speed_mps"])
+        except (KeyError, TypeError, ValueError):
+            raise CosimError("FMUstate", "the FMU state is not one this FMU wrote") from None
+        if z.shape != self.z.shape:
+            raise CosimError("FMUstate", f"the FMU state holds {z.size} values; {self.vehicle.name} needs {self.m}")
+        if not (np.all(np.isfinite(z)) and math.isfinite(t) and math.isfinite(last)):
+            raise CosimError("FMUstate", "the FMU state holds numbers that are not finite")
+        self.z, self.time, self.clamped, self.last_speed_mps = z, t, clamped, last
+
+
+def state_to_bytes(state: dict) -> bytes:
+    """Serialize a slave state: a magic line, then JSON."""
+    return (STATE_MAGIC + "\n" + json.dumps(state, allow_nan=False)).encode("utf-8")
+
+
+def state_from_bytes(data: bytes) -> dict:
+    """Parse :func:`state_to_bytes`; raise ``ValueError`` for anything else."""
+    text = bytes(data).decode("utf-8")
+    magic, _, body = text.partition("\n")
+    if magic != STATE_MAGIC:
+        raise ValueError("not an FMU state written by this FMU")
+    state = json.loads(body)
+    if not isinstance(state, dict):
+        raise ValueError("not an FMU state written by this FMU")
+    return state

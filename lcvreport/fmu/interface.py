@@ -1,0 +1,281 @@
+"""The FMU interface table: every variable of an FMU, declared once.
+
+One :class:`FmuVariable` per variable (name, value reference, causality,
+variability, type, unit, display unit, start, description, and the *source* the
+engine reads it from).  Both modelDescription.xml files
+(:mod:`lcvreport.fmu.model_description`), the C header's ``ValueReference`` enum
+(:mod:`lcvreport.fmu.build`), the pythonfmu slave's registration and the engine's
+output addressing (:mod:`lcvreport.fmu.engine`) are generated from this table,
+the way FMPy's ``ModelVariable`` has one writer and Reference-FMUs' ``config.h``
+one enum.
+
+Two interfaces (SPEC sections 5 and 9):
+
+* :func:`preset_interface`: ``LCV`` / ``LCVNative`` -- a ``preset`` parameter picks one
+  of the six thesis vehicles; inputs ``P11 .. P61``, ``T11 .. T61`` of the thesis axles;
+  outputs for six units (0 where the preset has fewer), joints lettered ``thetaA ..
+  thetaE``, and ``ay1 .. ay6`` appended after the SPEC section 5 outputs (their value
+  references are unchanged).
+* :func:`vehicle_interface`: the vehicle built in; inputs ``P_<axle>``, ``T_<axle>``;
+  outputs ``v1, r1..rN, theta1..theta(N-1), ay1..ayN, y2..yN, psi1, Y1, Y_rear,
+  max_real_eig``.
+
+Examples
+--------
+>>> itf = preset_interface()
+>>> itf.by_name["y6"].value_reference, itf.by_name["ay1"].value_reference
+(37, 42)
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..model.presets import PRESETS
+from ..model.vehicle import Vehicle, joint_letter
+from ..ranges import RANGES
+
+#: default forward speed [m/s] (50 mph = 22.352 m/s exactly)
+U_START = 22.352
+#: default lowest speed the model is run at [m/s] (5 mph = 2.2352 m/s exactly)
+U_MIN_DEFAULT = 2.2352
+#: the thesis' axle names of the preset FMU's P/T inputs (unit, axle)
+PRESET_AXLES = ("11", "12", "13", "21", "31", "41", "51", "61")
+#: units and joints of the preset FMU's outputs (the triple)
+PRESET_UNITS = 6
+#: FMI unit name of each quantity kind (SI)
+UNITS = {"speed": "m/s", "angle": "rad", "rate": "rad/s", "force": "N", "moment": "N.m", "length": "m",
+         "accel": "m/s2", "per_s": "1/s", "factor": "1", "none": ""}
+#: display unit of each quantity kind: the preset FMU keeps the thesis' (SPEC section 5),
+#: vehicle FMUs show km/h, degrees and SI
+DISPLAY_UNITS = {
+    "thesis": {"speed": "mph", "angle": "deg", "rate": "deg/s", "force": "lbf", "moment": "lbf.ft", "length": "in"},
+    "si": {"speed": "km/h", "angle": "deg", "rate": "deg/s"},
+}
+
+
+@dataclass(frozen=True)
+class FmuVariable:
+    """One FMU variable.
+
+    Attributes
+    ----------
+    name : str
+    value_reference : int
+    causality : {"parameter", "input", "output"}
+    variability : {"fixed", "continuous"}
+    type : {"Real", "String"}
+    quantity : str
+        Key of :data:`UNITS` (the FMI unit and display unit follow from it).
+    start : float, str or None
+        Start value (parameters and inputs).
+    description : str
+    source : tuple
+        What the engine reads or writes: ``("parameter", name)``, ``("speed",)``,
+        ``("steer",)``, ``("P", axle)``, ``("T", axle)``, ``("state", state_name)``,
+        ``("ay", unit)``, ``("y", unit)``, ``("psi1",)``, ``("Y1",)``, ``("Y_rear",)``,
+        ``("max_real_eig",)``; units 1-based.
+    minimum, maximum : float or None
+        Valid range (from :data:`lcvreport.ranges.RANGES`), written as min/max.
+    display_unit : str
+        Display unit ('' for none).
+    """
+
+    name: str
+    value_reference: int
+    causality: str
+    variability: str
+    type: str
+    quantity: str
+    start: float | str | None
+    description: str
+    source: tuple
+    minimum: float | None = None
+    maximum: float | None = None
+    display_unit: str = ""
+
+    @property
+    def unit(self) -> str:
+        """FMI unit name ('' for none)."""
+        return UNITS[self.quantity]
+
+
+@dataclass(frozen=True)
+class Interface:
+    """The variables of one FMU and the vehicles it can run.
+
+    Attributes
+    ----------
+    model_name : str
+        The FMU's model name and (for the pythonfmu FMU) model identifier.
+    variables : tuple of FmuVariable
+        In value-reference order (vr = index).
+    vehicles : tuple of Vehicle
+        The vehicle built in, or the six presets (``preset`` parameter picks one).
+    preset_mode : bool
+        True for the SPEC section 5 interface (a ``preset`` String parameter).
+    description : str
+    """
+
+    model_name: str
+    variables: tuple[FmuVariable, ...]
+    vehicles: tuple[Vehicle, ...]
+    preset_mode: bool
+    description: str = ""
+    by_name: dict = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "by_name", {v.name: v for v in self.variables})
+        for i, v in enumerate(self.variables):
+            assert v.value_reference == i, "value references must be the table index"
+
+    def of(self, causality: str) -> tuple[FmuVariable, ...]:
+        """The variables of one causality, in value-reference order."""
+        return tuple(v for v in self.variables if v.causality == causality)
+
+    @property
+    def inputs(self) -> tuple[FmuVariable, ...]:
+        return self.of("input")
+
+    @property
+    def outputs(self) -> tuple[FmuVariable, ...]:
+        return self.of("output")
+
+    @property
+    def parameters(self) -> tuple[FmuVariable, ...]:
+        return self.of("parameter")
+
+    def vehicle(self, preset: str | None = None) -> Vehicle:
+        """The vehicle of this FMU (in preset mode, the preset named ``preset``)."""
+        if not self.preset_mode:
+            return self.vehicles[0]
+        for v in self.vehicles:
+            if v.name == preset:
+                return v
+        raise KeyError(f"preset: unknown preset {preset!r}; valid: {', '.join(v.name for v in self.vehicles)}")
+
+    def rows(self) -> list[dict]:
+        """The table as rows (name, value reference, causality, variability, unit, display unit,
+        start, description), for documentation and reports."""
+        return [{"name": v.name, "value_reference": v.value_reference, "causality": v.causality,
+                 "variability": v.variability, "unit": v.unit, "display_unit": v.display_unit,
+                 "start": "" if v.start is None else v.start, "description": v.description} for v in self.variables]
+
+
+class _Table:
+    def __init__(self, display: str):
+        self.vars: list[FmuVariable] = []
+        self.display = DISPLAY_UNITS[display]
+
+    def add(self, name, causality, variability, quantity, start, description, source, type_="Real", range_key=None):
+        lo = hi = None
+        if range_key is not None:
+            r = RANGES[range_key]
+            lo, hi = r.low, r.high
+        self.vars.append(FmuVariable(name, len(self.vars), causality, variability, type_, quantity, start,
+                                     description, source, lo, hi, self.display.get(quantity, "")))
+
+
+def _parameters(t: _Table) -> None:
+    t.add("tire_scale", "parameter", "fixed", "factor", 1.0,
+          f"Factor on every tire coefficient C_F, C_M, C_S (chapter V), in {RANGES['tire_scale'].text()}",
+          ("parameter", "tire_scale"), range_key="tire_scale")
+    t.add("u_min", "parameter", "fixed", "speed", U_MIN_DEFAULT,
+          "Lowest forward speed the linear model is run at; a lower input u is clamped to it "
+          f"(one warning), in {RANGES['u_min'].text()}", ("parameter", "u_min"), range_key="u_min")
+
+
+def _speed_and_steer(t: _Table, steer_text: str) -> None:
+    t.add("u", "input", "continuous", "speed", U_START,
+          f"Forward speed of every unit, held over each communication step; at most {RANGES['speed'].high:g} m/s",
+          ("speed",))
+    t.add("delta", "input", "continuous", "angle", 0.0,
+          f"Steer angle of {steer_text}, positive nose-right (toward +y), in {RANGES['steer_angle'].text()}",
+          ("steer",), range_key="steer_angle")
+
+
+def _tail_outputs(t: _Table, last: str) -> None:
+    t.add("psi1", "output", "continuous", "angle", None, "Tractor heading (yaw angle) from the start, nose-right "
+          "positive", ("psi1",))
+    t.add("Y1", "output", "continuous", "length", None, "Global lateral position of the tractor CG from the start, +y",
+          ("Y1",))
+    t.add("Y_rear", "output", "continuous", "length", None,
+          f"Global lateral position of the rear end of {last} from the start, +y (first order)", ("Y_rear",))
+    t.add("max_real_eig", "output", "continuous", "per_s", None,
+          "Largest real part of the eigenvalues at the current (clamped) speed: negative = stable", ("max_real_eig",))
+
+
+def preset_interface() -> Interface:
+    """The SPEC section 5 interface (``LCV``/``LCVNative``), with ``ay1 .. ay6`` appended."""
+    from ..model.presets import load_preset
+    t = _Table("thesis")
+    t.add("preset", "parameter", "fixed", "none", PRESETS[0], "Vehicle preset: " + ", ".join(PRESETS),
+          ("parameter", "preset"), type_="String")
+    _parameters(t)
+    _speed_and_steer(t, "the tractor steer axle 11")
+    for a in PRESET_AXLES:
+        t.add(f"P{a}", "input", "continuous", "force", 0.0, f"Residual lateral force (conicity, ply steer) of axle "
+              f"{a} (axle {a[1]} of unit {a[0]}), along +y (curb side); ignored if the preset lacks the axle",
+              ("P", a), range_key="residual_force")
+    for a in PRESET_AXLES:
+        t.add(f"T{a}", "input", "continuous", "moment", 0.0, f"Residual aligning moment of axle {a} (axle {a[1]} of "
+              f"unit {a[0]}), about +z (down), positive nose-right; ignored if the preset lacks the axle",
+              ("T", a), range_key="residual_moment")
+    t.add("v1", "output", "continuous", "speed", None, "Tractor lateral velocity at the CG, +y", ("state", "v1"))
+    for i in range(1, PRESET_UNITS + 1):
+        t.add(f"r{i}", "output", "continuous", "rate", None, f"Yaw rate of unit {i} (1 tractor, 2 trailer 1, 3 dolly 1, "
+              "4 trailer 2, 5 dolly 2, 6 trailer 3), nose-right positive; 0 if the preset lacks the unit",
+              ("state", f"r{i}"))
+    for k in range(PRESET_UNITS - 1):
+        j = joint_letter(k)
+        t.add(f"theta{j}", "output", "continuous", "angle", None, f"Articulation angle at joint {j} (heading of the "
+              "unit ahead minus the unit behind); 0 if the preset lacks the joint", ("state", f"theta{j}"))
+    for k in range(2, PRESET_UNITS + 1):
+        t.add(f"y{k}", "output", "continuous", "length", None, f"Lateral displacement of the rear end of unit {k} "
+              "relative to the tractor axis (eq. 4.42-4.46); 0 if the preset lacks the unit", ("y", k))
+    _tail_outputs(t, "the last unit")
+    for i in range(1, PRESET_UNITS + 1):
+        t.add(f"ay{i}", "output", "continuous", "accel", None, f"Lateral acceleration of the CG of unit {i}, "
+              "a = v' + u r, at the current state and inputs; 0 if the preset lacks the unit", ("ay", i))
+    return Interface("LCV", tuple(t.vars), tuple(load_preset(p) for p in PRESETS), True,
+                     "Linear yaw-plane model of a long combination vehicle (tractor, semitrailers, converter "
+                     "dollies) with residual tire forces (conicity, ply steer); Patterson (2011). Exact "
+                     "zero-order-hold stepping for any communication step size.")
+
+
+def vehicle_interface(vehicle: Vehicle) -> Interface:
+    """The SPEC section 9 interface of an FMU with ``vehicle`` built in."""
+    t = _Table("si")
+    _parameters(t)
+    steered = vehicle.steered_axles
+    steer_text = ("axles " + ", ".join(a.name for a in steered)) if steered else "no axle (none is steered)"
+    _speed_and_steer(t, steer_text)
+    for i, u in enumerate(vehicle.units):
+        for a in u.axles:
+            t.add(f"P_{a.name}", "input", "continuous", "force", 0.0, f"Residual lateral force (conicity, ply steer) "
+                  f"of axle {a.name} of {u.name} (unit {i + 1}), along +y", ("P", a.name), range_key="residual_force")
+    for i, u in enumerate(vehicle.units):
+        for a in u.axles:
+            t.add(f"T_{a.name}", "input", "continuous", "moment", 0.0, f"Residual aligning moment of axle {a.name} of "
+                  f"{u.name} (unit {i + 1}), about +z (down), positive nose-right", ("T", a.name),
+                  range_key="residual_moment")
+    n = vehicle.n_units
+    t.add("v1", "output", "continuous", "speed", None, f"Lateral velocity of the CG of {vehicle.units[0].name}, +y",
+          ("state", "v1"))
+    for i, u in enumerate(vehicle.units):
+        t.add(f"r{i + 1}", "output", "continuous", "rate", None, f"Yaw rate of {u.name} (unit {i + 1}), nose-right "
+              "positive", ("state", f"r{i + 1}"))
+    for k in range(n - 1):
+        t.add(f"theta{k + 1}", "output", "continuous", "angle", None, f"Articulation angle at joint {k + 1} "
+              f"({vehicle.units[k].name} - {vehicle.units[k + 1].name}, heading of the unit ahead minus the unit "
+              "behind)", ("state", f"theta{joint_letter(k)}"))
+    for i, u in enumerate(vehicle.units):
+        t.add(f"ay{i + 1}", "output", "continuous", "accel", None, f"Lateral acceleration of the CG of {u.name} "
+              f"(unit {i + 1}), a = v' + u r, at the current state and inputs", ("ay", i + 1))
+    for k in range(2, n + 1):
+        t.add(f"y{k}", "output", "continuous", "length", None, f"Lateral offset of the rear end of "
+              f"{vehicle.units[k - 1].name} (unit {k}) from the axis of {vehicle.units[0].name}", ("y", k))
+    _tail_outputs(t, vehicle.units[-1].name)
+    desc = (f"Linear yaw-plane model of {vehicle.name} ({n} units: {', '.join(vehicle.unit_names)}) with residual "
+            "tire forces (conicity, ply steer). Exact zero-order-hold stepping for any communication step size."
+            + (f" {vehicle.description}" if vehicle.description else ""))
+    return Interface(vehicle.name, tuple(t.vars), (vehicle,), False, desc)

@@ -1,0 +1,154 @@
+"""modelDescription.xml from the interface table: one writer for both FMUs.
+
+Units and display units (``<UnitDefinitions>``, factors from :mod:`lcvreport.units`),
+min/max from :mod:`lcvreport.ranges`, ``<ModelStructure>`` with the outputs'
+direct dependencies and the initial unknowns, a guid that is a hash of the content
+(no timestamp: the same vehicle gives the same file).
+
+Examples
+--------
+>>> from lcvreport.fmu.interface import preset_interface
+>>> xml = model_description(preset_interface(), "LCVNative", native=True)
+>>> b'modelIdentifier="LCVNative"' in xml
+True
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+import uuid
+from xml.etree.ElementTree import Element, SubElement, indent, tostring
+
+from ..units import M_PER_FT, M_PER_IN, MPS_PER_MPH, N_PER_LBF, NM_PER_LBF_FT, NM_PER_LBF_IN, S_PER_HOUR
+from .interface import FmuVariable, Interface
+
+#: FMI unit name -> (SI base-unit exponents, [(display unit, factor)]): display = factor * value
+UNIT_DEFINITIONS = {
+    "m/s": ({"m": 1, "s": -1}, [("mph", 1 / MPS_PER_MPH), ("km/h", S_PER_HOUR / 1000.0)]),
+    "m": ({"m": 1}, [("in", 1 / M_PER_IN), ("ft", 1 / M_PER_FT), ("mm", 1000.0)]),
+    "rad": ({"rad": 1}, [("deg", 180.0 / math.pi)]),
+    "rad/s": ({"rad": 1, "s": -1}, [("deg/s", 180.0 / math.pi)]),
+    "N": ({"kg": 1, "m": 1, "s": -2}, [("lbf", 1 / N_PER_LBF), ("kN", 1e-3)]),
+    "N.m": ({"kg": 1, "m": 2, "s": -2}, [("lbf.ft", 1 / NM_PER_LBF_FT), ("lbf.in", 1 / NM_PER_LBF_IN)]),
+    "m/s2": ({"m": 1, "s": -2}, [("g", 1 / 9.80665)]),
+    "1/s": ({"s": -1}, []),
+    "1": ({}, []),
+}
+#: log categories of both FMUs
+LOG_CATEGORIES = {
+    "logStatusWarning": "Log messages with fmi2Warning status (speed clamped to u_min).",
+    "logStatusError": "Log messages with fmi2Error status (bad parameter, input or call).",
+    "logAll": "Log all messages.",
+}
+#: default experiment
+DEFAULT_EXPERIMENT = {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.001"}
+
+
+def _direct_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
+    """Inputs an output depends on directly (feedthrough)."""
+    kind = v.source[0]
+    if kind == "ay":
+        return [w.name for w in itf.inputs]
+    if kind == "max_real_eig":
+        return ["u"]
+    return []
+
+
+def _initial_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
+    """Inputs and parameters an output depends on at initialization."""
+    kind = v.source[0]
+    params = [p.name for p in itf.parameters]
+    if kind == "ay":
+        return [w.name for w in itf.inputs] + params
+    if kind == "max_real_eig":
+        return ["u"] + params
+    return []
+
+
+def guid(itf: Interface, model_identifier: str) -> str:
+    """A guid derived from the interface and the vehicles' numbers (reproducible)."""
+    h = hashlib.sha256()
+    h.update(model_identifier.encode())
+    for v in itf.variables:
+        h.update(repr((v.name, v.causality, v.variability, v.unit, v.start, v.source)).encode())
+    for veh in itf.vehicles:
+        h.update(repr(veh).encode())
+    return "{" + str(uuid.UUID(bytes=h.digest()[:16], version=5)) + "}"
+
+
+def _num(x: float) -> str:
+    return repr(float(x))
+
+
+def model_description(itf: Interface, model_identifier: str, native: bool, generation_tool: str = "lcvreport"
+                      ) -> bytes:
+    """The modelDescription.xml of an FMU of ``itf``.
+
+    Parameters
+    ----------
+    itf : Interface
+    model_identifier : str
+        File stem of the FMU and of its binary.
+    native : bool
+        True for the C FMU (no execution tool); False for the pythonfmu FMU.
+    generation_tool : str
+    """
+    root = Element("fmiModelDescription", {
+        "fmiVersion": "2.0", "modelName": model_identifier, "guid": guid(itf, model_identifier),
+        "description": itf.description + ("" if not native else " Native C implementation: no Python at run time."),
+        "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": generation_tool,
+        "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
+    SubElement(root, "CoSimulation", {
+        "modelIdentifier": model_identifier, "needsExecutionTool": "false",
+        "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
+        "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
+        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
+        "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
+        "providesDirectionalDerivative": "false"})
+    used = sorted({v.unit for v in itf.variables if v.unit})
+    defs = SubElement(root, "UnitDefinitions")
+    for name in used:
+        base, displays = UNIT_DEFINITIONS[name]
+        unit = SubElement(defs, "Unit", name=name)
+        SubElement(unit, "BaseUnit", {k: str(e) for k, e in base.items()})
+        for dname, factor in displays:
+            SubElement(unit, "DisplayUnit", {"name": dname, "factor": _num(factor)})
+    cats = SubElement(root, "LogCategories")
+    for name, text in LOG_CATEGORIES.items():
+        SubElement(cats, "Category", name=name, description=text)
+    SubElement(root, "DefaultExperiment", DEFAULT_EXPERIMENT)
+    mv = SubElement(root, "ModelVariables")
+    for v in itf.variables:
+        attrs = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
+                 "causality": v.causality, "variability": v.variability}
+        if v.causality == "output":
+            attrs["initial"] = "calculated"
+        elif v.causality == "parameter":
+            attrs["initial"] = "exact"
+        sv = SubElement(mv, "ScalarVariable", attrs)
+        if v.type == "String":
+            SubElement(sv, "String", {"start": str(v.start)})
+            continue
+        real = {}
+        if v.unit:
+            real["unit"] = v.unit
+        if v.display_unit:
+            real["displayUnit"] = v.display_unit
+        if v.minimum is not None and v.causality == "parameter":
+            real["min"] = _num(v.minimum)
+            real["max"] = _num(v.maximum)
+        if v.start is not None:
+            real["start"] = _num(v.start)
+        SubElement(sv, "Real", real)
+    index = {v.name: v.value_reference + 1 for v in itf.variables}
+    ms = SubElement(root, "ModelStructure")
+    outs = SubElement(ms, "Outputs")
+    init = SubElement(ms, "InitialUnknowns")
+    for v in itf.outputs:
+        deps = " ".join(str(index[n]) for n in _direct_dependencies(itf, v))
+        SubElement(outs, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
+    for v in itf.outputs:
+        deps = " ".join(str(index[n]) for n in _initial_dependencies(itf, v))
+        SubElement(init, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
+    indent(root)
+    return b'<?xml version="1.0" encoding="UTF-8"?>\n' + tostring(root, encoding="utf-8") + b"\n"

@@ -1,0 +1,76 @@
+"""The thesis vehicles as presets: vehicle files shipped in ``lcvreport/data/vehicles``.
+
+``aucnat``, ``legal_max``, ``loaded_loaded_empty``, ``empty_empty_loaded`` and
+``empty`` are the five triple-trailer configurations of Appendices B-D;
+``tractor_semitrailer`` is the AU-NCAT tractor with trailer 1 (chapter III).  The
+files are SI conversions of the thesis tables (:mod:`lcvreport.thesis.vehicles`)
+with the printed (rounded) masses; ``masses="unrounded"`` gives the masses the
+published matrices imply (SPEC section 3), for aucnat and tractor_semitrailer.
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> v = load_preset("aucnat")
+>>> v.n_units, v.unit_names[-1]
+(6, 'trailer3')
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+from importlib import resources
+
+from .vehicle import Vehicle
+from .vehicle_file import loads_vehicle
+
+#: preset names, in the order the thesis introduces them
+PRESETS = ("aucnat", "legal_max", "loaded_loaded_empty", "empty_empty_loaded", "empty", "tractor_semitrailer")
+#: a readable label per preset
+PRESET_LABELS = {
+    "aucnat": "AU-NCAT (as tested)",
+    "legal_max": "Legal Max",
+    "loaded_loaded_empty": "Loaded, Loaded, Empty",
+    "empty_empty_loaded": "Empty, Empty, Loaded",
+    "empty": "Empty",
+    "tractor_semitrailer": "AU-NCAT tractor + trailer 1",
+}
+#: options of ``masses``
+MASS_OPTIONS = ("table", "unrounded")
+
+
+def check_preset(name: str) -> str:
+    """Return ``name`` if it is a preset, else raise ``KeyError`` listing the valid ones."""
+    if name not in PRESETS:
+        raise KeyError(f"unknown preset {name!r}; valid presets: {', '.join(PRESETS)}")
+    return name
+
+
+def preset_path(name: str):
+    """The shipped vehicle file of preset ``name`` (an importlib resource)."""
+    return resources.files("lcvreport").joinpath("data", "vehicles", f"{check_preset(name)}.toml")
+
+
+@lru_cache(maxsize=None)
+def load_preset(name: str, masses: str = "table") -> Vehicle:
+    """Load a preset vehicle.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`PRESETS`.
+    masses : {"table", "unrounded"}
+        ``table`` keeps Table C's rounded masses; ``unrounded`` uses the masses implied
+        by eq. 3.17/3.18 (tractor_semitrailer) or eq. 4.14 (aucnat).
+
+    Returns
+    -------
+    Vehicle
+        SI.
+    """
+    check_preset(name)
+    if masses not in MASS_OPTIONS:
+        raise ValueError(f"masses must be one of {', '.join(MASS_OPTIONS)}, got {masses!r}")
+    vehicle = loads_vehicle(preset_path(name).read_text(encoding="utf-8"), source=f"preset {name}")
+    if masses == "unrounded":
+        from ..thesis.vehicles import unrounded_masses_kg  # the thesis' own correction of its Table C
+        vehicle = vehicle.with_masses(unrounded_masses_kg(name))
+    return vehicle

@@ -1,0 +1,169 @@
+"""The assessment report of one vehicle at one speed: what its notebook shows.
+
+Rows of its tables and its figures, each computed by :mod:`lcvreport.analysis` and
+drawn by :mod:`lcvreport.report.plotting`; the notebook ``notebooks/assessment.ipynb``
+only lays them out with captions that name the vehicle and the speed.
+
+Examples
+--------
+>>> a = Assessment.load(preset="tractor_semitrailer", speed_kph=88.0, fast=True)
+>>> a.at
+'tractor_semitrailer at 88 km/h'
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from ..analysis import measures
+from ..analysis.modes import Modes, modes
+from ..fmu.interface import vehicle_interface
+from ..model.presets import load_preset
+from ..model.vehicle import Vehicle
+from ..model.vehicle_file import load_vehicle
+from ..units import kph_to_mps
+from . import plotting
+
+#: speed range of the root locus and of the damping curve [km/h] (SPEC section 10)
+SWEEP_KPH = (10.0, 130.0)
+#: frequency range of the RA curves [Hz]
+RA_CURVE_HZ = (0.1, 2.0)
+
+
+@dataclass
+class Assessment:
+    """One vehicle at one speed, with the loads of the trim (optional)."""
+
+    vehicle: Vehicle
+    speed_kph: float
+    load_units: tuple[str, ...] = ()
+    fast: bool = False
+    source: str = ""
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    @classmethod
+    def load(cls, preset: str | None = None, vehicle_file: str | None = None, speed_kph: float = 88.0,
+             load_units=None, fast: bool = False) -> "Assessment":
+        """From a preset name or a vehicle file."""
+        vehicle = load_preset(preset) if preset is not None else load_vehicle(vehicle_file)
+        return cls(vehicle, float(speed_kph), tuple(load_units or ()), fast,
+                   f"preset {preset}" if preset is not None else str(vehicle_file))
+
+    @property
+    def speed_mps(self) -> float:
+        return kph_to_mps(self.speed_kph)
+
+    @property
+    def at(self) -> str:
+        """``<vehicle> at <speed> km/h`` for captions."""
+        return f"{self.vehicle.name} at {self.speed_kph:g} km/h"
+
+    # ------------------------------------------------------------------ data
+    def fig_vehicle(self):
+        return plotting.fig_vehicle(self.vehicle, f"{self.vehicle.name}: {self.vehicle.n_units} units")
+
+    def unit_rows(self) -> list[dict]:
+        """Units: mass, inertia, couplings, rear end (SI)."""
+        v = self.vehicle
+        return [{"unit": k + 1, "name": u.name, "mass_kg": u.mass_kg, "yaw_inertia_kg_m2": u.yaw_inertia_kg_m2,
+                 "front_coupling_m": "" if u.front_coupling_m is None else u.front_coupling_m,
+                 "rear_coupling_m": "" if u.rear_coupling_m is None else u.rear_coupling_m,
+                 "rear_end_m": v.rear_end_x_m(k), "axles": len(u.axles)} for k, u in enumerate(v.units)]
+
+    def axle_rows(self) -> list[dict]:
+        """Axles: position, tires, per-tire coefficients, dual spacing, steer, load (SI)."""
+        return [{"axle": a.name, "unit": self.vehicle.units[i].name, "x_m": a.x_m, "tires": a.tires,
+                 "C_F_N_per_rad": a.cornering_stiffness_N_per_rad, "C_M_Nm_per_rad": a.aligning_stiffness_Nm_per_rad,
+                 "C_S_N": a.longitudinal_stiffness_N, "D_m": a.dual_spacing_m, "steered": a.steered,
+                 "static_load_N": "" if a.static_load_N is None else a.static_load_N}
+                for i, a in zip(self.vehicle.axle_units, self.vehicle.axles)]
+
+    # ------------------------------------------------------------------ modes
+    @cached_property
+    def modes(self) -> Modes:
+        return modes(self.vehicle, self.speed_mps)
+
+    def mode_rows(self) -> list[dict]:
+        """Eigenvalues [1/s], damped frequency [Hz], damping ratio, time constant [s]; * marks the least damped."""
+        k = self.modes.least_damped
+        return [{**row, "time_constant_s": float(tc), "least_damped": "*" if k is not None and i in (k, k + 1) else ""}
+                for i, (row, tc) in enumerate(zip(self.modes.table(), self.modes.time_constant))]
+
+    def least_damped_modes(self, count: int = 2) -> list[int]:
+        """Indices of the ``count`` least damped oscillatory modes (+Im members)."""
+        m = self.modes
+        idx = np.flatnonzero(m.eigenvalues.imag > 0)
+        return [int(i) for i in idx[np.argsort(m.damping_ratio[idx])][:count]]
+
+    def fig_mode(self, index: int):
+        return plotting.fig_mode_shape(self.vehicle, self.modes, index, f"Mode {index + 1}")
+
+    # ------------------------------------------------------------------ stability over speed
+    @cached_property
+    def sweep(self) -> measures.SpeedSweep:
+        lo, hi = SWEEP_KPH
+        return measures.speed_sweep(self.vehicle, np.linspace(lo, hi, 25 if self.fast else 121))
+
+    def fig_root_locus(self):
+        return plotting.fig_root_locus(self.sweep.speeds_kph, self.sweep.eigenvalues,
+                                       f"Root locus of {self.vehicle.name}, {SWEEP_KPH[0]:g}-{SWEEP_KPH[1]:g} km/h",
+                                       self.sweep.critical_speed_kph)
+
+    def fig_damping(self):
+        return plotting.fig_damping_over_speed(self.sweep.speeds_kph, self.sweep.least_damping_ratio,
+                                               self.sweep.max_real, self.vehicle.name, self.sweep.critical_speed_kph,
+                                               self.speed_kph)
+
+    # ------------------------------------------------------------------ rearward amplification
+    @cached_property
+    def frequencies_hz(self) -> np.ndarray:
+        return np.linspace(*RA_CURVE_HZ, 40 if self.fast else 191)
+
+    def fig_ra(self):
+        f = self.frequencies_hz
+        G = np.abs(measures.steer_to_acceleration(self.vehicle, self.speed_mps, f))
+        curves = [(f"RA = |G_{self.vehicle.n_units}| / |G_1|", G[:, -1] / G[:, 0])]
+        return plotting.fig_frequency(f, curves, "rearward amplification [-]",
+                                      f"Rearward amplification of {self.at}", measures.RA_FREQUENCY_HZ)
+
+    def fig_gains(self):
+        f = self.frequencies_hz
+        G = np.abs(measures.steer_to_acceleration(self.vehicle, self.speed_mps, f))
+        curves = [(f"|G_{i + 1}| {name}", G[:, i]) for i, name in enumerate(self.vehicle.unit_names)]
+        return plotting.fig_frequency(f, curves, "lateral acceleration per steer angle [m/s^2/rad]",
+                                      f"Steer-to-lateral-acceleration gains of {self.at}", measures.RA_FREQUENCY_HZ,
+                                      logy=True)
+
+    @cached_property
+    def single_sine(self) -> measures.SingleSine:
+        return measures.single_sine(self.vehicle, self.speed_mps)
+
+    # ------------------------------------------------------------------ measures and conicity
+    @cached_property
+    def measures(self) -> measures.MeasureSet:
+        return measures.measure_set(self.vehicle, self.speed_mps, load_units=list(self.load_units) or None)
+
+    @cached_property
+    def sensitivity(self) -> list[measures.AxleSensitivity]:
+        return measures.conicity_sensitivity(self.vehicle, self.speed_mps)
+
+    def sensitivity_rows(self) -> list[dict]:
+        return [{"rank": k + 1, "axle": s.axle, "unit": s.unit,
+                 "offtracking_per_kN_of_P_mm": 1e3 * s.offtracking_per_P_m_per_kN,
+                 "offtracking_per_kNm_of_T_mm": 1e3 * s.offtracking_per_T_m_per_kNm,
+                 "trim_steer_per_kN_of_P_mrad": 1e3 * s.delta_per_P_rad_per_kN,
+                 "trim_steer_per_kNm_of_T_mrad": 1e3 * s.delta_per_T_rad_per_kNm}
+                for k, s in enumerate(self.sensitivity)]
+
+    def fig_sensitivity(self):
+        rows = self.sensitivity
+        return plotting.fig_bars([f"{s.axle} ({s.unit})" for s in rows],
+                                 [("per kN of P", np.array([1e3 * s.offtracking_per_P_m_per_kN for s in rows])),
+                                  ("per kN*m of T", np.array([1e3 * s.offtracking_per_T_m_per_kNm for s in rows]))],
+                                 "trimmed offtracking [mm]", f"Conicity sensitivity of {self.at}, ranked")
+
+    # ------------------------------------------------------------------ FMU
+    def interface_rows(self) -> list[dict]:
+        return vehicle_interface(self.vehicle).rows()

@@ -1,0 +1,456 @@
+"""Report orchestration: papermill executes the notebooks, nbconvert builds one HTML and
+one PDF.
+
+Two reports:
+
+* **the thesis report** (``./build.sh report``, ``python -m lcvreport.report.build``):
+  the six notebooks of the dissertation's chapters and the audit, into
+  ``<build>/report/index.html``, ``report.pdf`` and ``data/*.csv``;
+* **the assessment report** of any vehicle (``lcv report``, :func:`build_assessment`):
+  ``notebooks/assessment.ipynb`` with the vehicle, the speed and the loads as
+  parameters, into ``<out>/index.html``, ``report.pdf`` and ``data/*.csv``.
+
+Every notebook declares its parameters here (:data:`NOTEBOOKS`); they are checked
+before any cell runs (:func:`check_notebook_parameters`, which the notebooks call too
+when run by papermill directly), so a bad value or a preset a notebook cannot serve
+stops with one message naming the parameter and what is valid.  Steps of a build:
+
+1. remove the previous ``index.html`` and ``report.pdf`` (a failed build never leaves
+   a stale report looking fresh);
+2. execute the notebooks with papermill (the venv's own ``python3`` kernel) into
+   ``<build>/notebooks/``; a failing notebook stops the build with its name and cell;
+3. merge the executed notebooks into one, without the parameter cells, and export it
+   with nbconvert to HTML (images embedded, MathJax shipped next to it from Debian's
+   ``libjs-mathjax``, so it reads offline) and PDF (LaTeX route, xelatex);
+4. tables and figure data are written as CSV by the notebooks themselves.
+"""
+from __future__ import annotations
+
+import argparse
+import copy
+import shutil
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Callable
+
+from ..model.loads import CONVENTIONS
+from ..model.presets import PRESETS, load_preset
+from ..ranges import RANGES
+from ..units import MPS_PER_KPH, MPS_PER_MPH
+
+TEMPLATES = Path(__file__).resolve().parent / "templates"
+MATHJAX = Path("/usr/share/javascript/mathjax")
+THESIS_TITLE = "Effect of conicity and ply steer on LCV yaw plane motion: the dissertation recomputed"
+#: the five triple-trailer presets (chapter IV and the mode shapes of chapter II need a triple)
+TRIPLES = PRESETS[:5]
+#: the assessment report's default speed [km/h]
+DEFAULT_SPEED_KPH = 88.0
+
+
+class ReportError(RuntimeError):
+    """A bad parameter, a failing notebook or a failing export; the message names where."""
+
+
+# ---------------------------------------------------------------------------- parameters
+def _bool(name, value, _ctx):
+    if not isinstance(value, bool):
+        raise ReportError(f"parameter {name} must be true or false, got {value!r}")
+
+
+def _data_dir(name, value, _ctx):
+    if value is not None and not isinstance(value, str):
+        raise ReportError(f"parameter {name} must be a folder path (text) or None, got {value!r}")
+
+
+def _speed(factor, unit):
+    def check(name, value, _ctx):
+        r = RANGES["speed"]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not r.contains(value / factor):
+            raise ReportError(f"parameter {name} must be a number in {r.text(factor, unit)}, got {value!r}")
+    return check
+
+
+def _t_end(name, value, _ctx):
+    r = RANGES["t_end"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (2.0 <= value <= r.high):
+        raise ReportError(f"parameter {name} must be a number in [2, {r.high:g}] s (the slowest time constant is "
+                          f"about 0.8 s), got {value!r}")
+
+
+def _preset(accepted):
+    def check(name, value, _ctx):
+        if value not in accepted:
+            why = "" if set(accepted) == set(PRESETS) else " (this notebook needs a triple: a dolly and three trailers)"
+            raise ReportError(f"parameter {name}: this notebook serves {', '.join(accepted)}{why}; got {value!r}")
+    return check
+
+
+def _convention(name, value, _ctx):
+    if value not in CONVENTIONS:
+        raise ReportError(f"parameter {name} must be one of {', '.join(CONVENTIONS)}, got {value!r}")
+
+
+def _load_units(name, value, ctx):
+    vehicle = ctx.get("vehicle")
+    valid = vehicle.unit_names if vehicle is not None else ()
+    if value is None and name == "load_units" and ctx.get("optional_loads"):
+        return
+    if not isinstance(value, (list, tuple)) or not value or any(u not in valid for u in value) \
+            or len(set(value)) != len(value):
+        raise ReportError(f"parameter {name} must be a non-empty list of distinct units from {', '.join(valid)}, "
+                          f"got {value!r}")
+
+
+def _vehicle_file(name, value, _ctx):
+    if value is not None and not isinstance(value, str):
+        raise ReportError(f"parameter {name} must be the path of a vehicle file or None, got {value!r}")
+
+
+@dataclass(frozen=True)
+class NotebookSpec:
+    """A notebook of a report: its anchor and title, and its parameters' checks."""
+
+    stem: str
+    anchor: str
+    title: str
+    parameters: dict = field(default_factory=dict)
+
+
+_COMMON = {"fast": _bool, "data_dir": _data_dir}
+#: the thesis report's notebooks in report order, with their parameters
+NOTEBOOKS = (
+    NotebookSpec("ch1_2_concepts", "ch1", "Chapters I and II: the vehicles, their oscillations, tire forces",
+                 {**_COMMON, "preset": _preset(TRIPLES), "speed_mph": _speed(1 / MPS_PER_MPH, "mph")}),
+    NotebookSpec("ch3_tractor_semitrailer", "ch3", "Chapter III: the tractor-semitrailer (4 DOF)",
+                 {**_COMMON, "speed_mph": _speed(1 / MPS_PER_MPH, "mph"), "t_end": _t_end}),
+    NotebookSpec("ch4_triple", "ch4", "Chapter IV: the triple trailer LCV (12 DOF)",
+                 {**_COMMON, "preset": _preset(TRIPLES), "speed_mph": _speed(1 / MPS_PER_MPH, "mph"),
+                  "load_units": _load_units, "convention": _convention, "t_end": _t_end}),
+    NotebookSpec("ch5_parametric", "ch5", "Chapter V: parametric study", {**_COMMON, "t_end": _t_end}),
+    NotebookSpec("appendices", "app", "Appendices B-E: dimensions, masses, tires, the 12-DOF matrices",
+                 {**_COMMON, "preset": _preset(PRESETS), "speed_mph": _speed(1 / MPS_PER_MPH, "mph")}),
+    NotebookSpec("audit", "audit", "Audit of the published numbers", {**_COMMON, "t_end": _t_end}),
+)
+#: the assessment report's notebook
+ASSESSMENT = NotebookSpec("assessment", "assessment", "Yaw-plane assessment",
+                          {**_COMMON, "preset": lambda n, v, c: None, "vehicle_file": _vehicle_file,
+                           "speed_kph": _speed(1 / MPS_PER_KPH, "km/h"), "load_units": _load_units})
+SPECS = {s.stem: s for s in NOTEBOOKS + (ASSESSMENT,)}
+
+
+def check_notebook_parameters(stem: str, values: dict, strict: bool = True) -> None:
+    """Check the parameters of notebook ``stem``.
+
+    Parameters
+    ----------
+    stem : str
+    values : dict
+        The parameters (``strict``: nothing else), or a notebook's ``globals()``.
+    strict : bool
+        Refuse names that are not parameters of the notebook.
+
+    Raises
+    ------
+    ReportError
+        Naming the first bad parameter and what is valid.
+    """
+    spec = SPECS[stem]
+    params = {k: values[k] for k in spec.parameters if k in values}
+    unknown = [k for k in values if k not in spec.parameters] if strict else []
+    if unknown:
+        raise ReportError(f"notebook {stem} has no parameter {unknown[0]!r}; its parameters: "
+                          f"{', '.join(spec.parameters)}")
+    ctx: dict = {}
+    if stem == "assessment":
+        ctx["optional_loads"] = True
+        if (params.get("preset") is None) == (params.get("vehicle_file") is None):
+            raise ReportError("parameters preset and vehicle_file: give exactly one")
+        if params.get("preset") is not None and params["preset"] not in PRESETS:
+            raise ReportError(f"parameter preset: unknown preset {params['preset']!r}; valid: {', '.join(PRESETS)}")
+        ctx["vehicle"] = _assessment_vehicle(params.get("preset"), params.get("vehicle_file"))
+    elif "preset" in params:
+        spec.parameters["preset"]("preset", params["preset"], ctx)
+        ctx["vehicle"] = load_preset(params["preset"])
+    for name, value in params.items():
+        spec.parameters[name](name, value, ctx)
+
+
+def _assessment_vehicle(preset, vehicle_file):
+    from ..model.vehicle import VehicleError
+    from ..model.vehicle_file import load_vehicle
+    if preset is not None:
+        return load_preset(preset)
+    try:
+        return load_vehicle(vehicle_file)
+    except VehicleError as exc:
+        raise ReportError(f"parameter vehicle_file {vehicle_file}: {exc}") from None
+
+
+# ---------------------------------------------------------------------------- execution
+def notebook_dir() -> Path:
+    """The report notebooks (``notebooks/`` in the repository, ``lcvreport/notebooks`` installed)."""
+    return Path(str(resources.files("lcvreport.notebooks")))
+
+
+def execute(stem: str, out_dir: Path, parameters: dict, source_dir: Path | None = None) -> Path:
+    """Check the parameters, then execute ``<source_dir>/<stem>.ipynb`` with papermill into ``out_dir``."""
+    import papermill as pm
+    if stem in SPECS:
+        check_notebook_parameters(stem, parameters)
+    src = (source_dir or notebook_dir()) / f"{stem}.ipynb"
+    dst = out_dir / f"{stem}.ipynb"
+    try:
+        pm.execute_notebook(str(src), str(dst), parameters=parameters, kernel_name="python3",
+                            cwd=str(out_dir), progress_bar=False, log_output=False)
+    except pm.PapermillExecutionError as exc:
+        where = _failed_cell(src, dst, exc.cell_index)
+        raise ReportError(f"notebook {src.name} failed in {where}: {exc.ename}: {exc.evalue} "
+                          f"(executed copy: {dst})") from None
+    return dst
+
+
+def _failed_cell(src: Path, executed: Path, fallback: int) -> str:
+    """'cell <i> (id <id>)' of the source notebook for the cell that raised."""
+    import nbformat
+    try:
+        run = nbformat.read(executed, as_version=4)
+        source = nbformat.read(src, as_version=4)
+        ids = [c.get("id") for c in source.cells]
+        for cell in run.cells:
+            if any(o.get("output_type") == "error" for o in cell.get("outputs", [])) and cell.get("id") in ids:
+                return f"cell {ids.index(cell['id'])} (id {cell['id']})"
+    except Exception:  # pragma: no cover - fall back to papermill's index
+        pass
+    return f"cell {fallback} of the executed copy"
+
+
+def merge(executed: list[tuple[str, str, str, Path]], title: str, intro: str):
+    """One notebook: title, table of contents, then every part without parameter cells."""
+    import nbformat
+    nb = nbformat.v4.new_notebook()
+    nb.metadata = {"title": title, "kernelspec": {"name": "python3", "display_name": "Python 3", "language": "python"},
+                   "language_info": {"name": "python"}}
+    toc = ["# " + title, "", intro, ""]
+    if len(executed) > 1:
+        toc += ["## Contents", ""] + [f"{i + 1}. [{t}](#{a})" for i, (_s, a, t, _p) in enumerate(executed)]
+    cells = [nbformat.v4.new_markdown_cell("\n".join(toc))]
+    for stem, anchor, part_title, path in executed:
+        src = nbformat.read(path, as_version=4)
+        if len(executed) > 1:
+            cells.append(nbformat.v4.new_markdown_cell(f'<a id="{anchor}"></a>\n\n# {part_title}'))
+        for cell in src.cells:
+            tags = cell.get("metadata", {}).get("tags", [])
+            if "parameters" in tags or "injected-parameters" in tags or "report-skip" in tags:
+                continue
+            c = copy.deepcopy(cell)
+            c.metadata = {}
+            if c.cell_type == "code":
+                c.execution_count = None
+                for out in c.get("outputs", []):
+                    if "execution_count" in out:
+                        out["execution_count"] = None
+            cells.append(c)
+    for i, c in enumerate(cells):
+        c["id"] = f"cell-{i:04d}"
+    nb.cells = cells
+    return nb
+
+
+def export_html(nb, out_dir: Path) -> Path:
+    """Self-contained HTML (figures inline), MathJax copied next to it."""
+    from nbconvert import HTMLExporter
+    exporter = HTMLExporter(template_name="lab", exclude_input=True, exclude_input_prompt=True,
+                            exclude_output_prompt=True, embed_images=True)
+    exporter.mathjax_url = "mathjax/MathJax.js?config=TeX-AMS_CHTML-full,Safe"
+    exporter.require_js_url = ""
+    body, _ = exporter.from_notebook_node(nb)
+    body = body.replace('<script src=""></script>', "")
+    if MATHJAX.exists():
+        dst = out_dir / "mathjax"
+        if not dst.exists():
+            shutil.copytree(MATHJAX, dst, symlinks=False, ignore=shutil.ignore_patterns("unpacked", "test"))
+    path = out_dir / "index.html"
+    path.write_text(body, encoding="utf-8")
+    return path
+
+
+def export_pdf(nb, out_dir: Path, author: str) -> Path:
+    """PDF through nbconvert's LaTeX route (xelatex) with the lcvlatex template."""
+    from nbconvert import PDFExporter
+    exporter = PDFExporter(template_name="lcvlatex", extra_template_basedirs=[str(TEMPLATES)], exclude_input=True,
+                           exclude_input_prompt=True, exclude_output_prompt=True)
+    exporter.latex_command = ["xelatex", "-interaction=batchmode", "-halt-on-error", "{filename}"]
+    try:
+        pdf, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": "report"}, "lcv_author": author})
+    except Exception as exc:  # nbconvert raises LatexFailed with the log
+        raise ReportError(f"PDF export (xelatex) failed: {str(exc)[-2000:]}") from None
+    path = out_dir / "report.pdf"
+    path.write_bytes(pdf)
+    return path
+
+
+def _prepare(out_dir: Path) -> tuple[Path, Path]:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for stale in (out_dir / "index.html", out_dir / "report.pdf"):
+        stale.unlink(missing_ok=True)
+    data_dir = out_dir / "data"
+    if data_dir.exists():
+        shutil.rmtree(data_dir)
+    data_dir.mkdir(parents=True)
+    return out_dir, data_dir
+
+
+def build(build_dir: Path, fast: bool = False, pdf: bool = True, only: list[str] | None = None,
+          jobs: int = 2, notebook_folder: Path | None = None, progress: Callable[[str], None] | None = None) -> dict:
+    """Execute the thesis notebooks and build the thesis report; return paths and timings.
+
+    ``notebook_folder`` replaces ``notebooks/`` (every ``*.ipynb`` in it, sorted, no
+    parameter checks) -- for tests."""
+    progress = progress or (lambda _text: None)
+    build_dir = Path(build_dir).resolve()
+    report_dir, data_dir = _prepare(build_dir / "report")
+    nb_dir = build_dir / "notebooks"
+    nb_dir.mkdir(parents=True, exist_ok=True)
+    if notebook_folder is None:
+        catalogue = [(s.stem, s.anchor, s.title) for s in NOTEBOOKS]
+        src = notebook_dir()
+    else:
+        src = Path(notebook_folder)
+        catalogue = [(p.stem, p.stem, p.stem) for p in sorted(src.glob("*.ipynb"))]
+    selected = [n for n in catalogue if only is None or n[0] in only]
+    params = {"fast": bool(fast), "data_dir": str(data_dir)}
+    t0 = time.perf_counter()
+
+    def run(item):
+        stem, anchor, title = item
+        t = time.perf_counter()
+        path = execute(stem, nb_dir, dict(params), src) if notebook_folder is None else \
+            _execute_unchecked(stem, nb_dir, params, src)
+        progress(f"notebook {stem}: {time.perf_counter() - t:.1f} s")
+        return stem, anchor, title, path
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = [pool.submit(run, n) for n in selected]
+        executed, errors = [], []
+        for fut in futures:
+            try:
+                executed.append(fut.result())
+            except ReportError as exc:
+                errors.append(str(exc))
+    if errors:
+        raise ReportError("\n".join(errors))
+    t_exec = time.perf_counter() - t0
+    intro = ("Every figure and table of J. J. Patterson, *Effect of conicity and ply steer on long combination "
+             "vehicle yaw plane motion* (University of Akron, 2011), recomputed from the model of `lcvreport`, side "
+             "by side with what was published, in two readings: **as published** (the thesis' load convention, its "
+             "modal method, its 1 s end time) and **corrected** (unit-consistent loads, the exact response, the true "
+             "steady state).")
+    nb = merge(executed, THESIS_TITLE, intro)
+    html = export_html(nb, report_dir)
+    progress("html written")
+    out = {"html": html, "data": data_dir, "seconds_execute": t_exec}
+    if pdf:
+        out["pdf"] = export_pdf(nb, report_dir, "Recomputed with lcvreport from Patterson (2011)")
+        progress("pdf written")
+    return out
+
+
+def _execute_unchecked(stem, nb_dir, params, src):
+    import papermill as pm
+    dst = nb_dir / f"{stem}.ipynb"
+    try:
+        pm.execute_notebook(str(src / f"{stem}.ipynb"), str(dst), parameters=params, kernel_name="python3",
+                            cwd=str(nb_dir), progress_bar=False, log_output=False)
+    except pm.PapermillExecutionError as exc:
+        where = _failed_cell(src / f"{stem}.ipynb", dst, exc.cell_index)
+        raise ReportError(f"notebook {stem}.ipynb failed in {where}: {exc.ename}: {exc.evalue} "
+                          f"(executed copy: {dst})") from None
+    return dst
+
+
+def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = None, load_units=None,
+                     pdf: bool = True, progress: Callable[[str], None] | None = None, fast: bool = False,
+                     source: str = "") -> dict:
+    """The assessment report of ``vehicle`` (SPEC section 10) into ``out_dir``.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        A preset (by name, when ``source`` is ``"preset <name>"``) or any vehicle; it is
+        written next to the report as ``vehicle.toml`` and the notebook reads that file.
+    out_dir : path
+    speed_mps : float, optional
+        Speed of the modes, measures and time histories [m/s] (default 88 km/h).
+    load_units : list of str, optional
+        Units carrying the 1 % rule for the trim.
+    pdf : bool
+    progress : callable, optional
+        Called with a line of text per step.
+    fast : bool
+        Coarser grids (tests).
+    source : str
+        Where the vehicle came from, for the report.
+
+    Returns
+    -------
+    dict
+        ``html``, ``pdf``, ``data`` paths and ``seconds``.
+    """
+    from ..model.vehicle_file import dumps_vehicle
+    progress = progress or (lambda _text: None)
+    out_dir, data_dir = _prepare(Path(out_dir).resolve())
+    speed_kph = DEFAULT_SPEED_KPH if speed_mps is None else speed_mps / MPS_PER_KPH
+    vehicle_file = out_dir / "vehicle.toml"
+    vehicle_file.write_text(dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name})."),
+                            encoding="utf-8")
+    params = {"fast": bool(fast), "data_dir": str(data_dir), "preset": None, "vehicle_file": str(vehicle_file),
+              "speed_kph": float(speed_kph), "load_units": list(load_units) if load_units else None}
+    t0 = time.perf_counter()
+    nb_dir = out_dir / "notebooks"
+    nb_dir.mkdir(exist_ok=True)
+    path = execute("assessment", nb_dir, params)
+    progress(f"notebook assessment: {time.perf_counter() - t0:.1f} s")
+    title = f"Yaw-plane assessment of {vehicle.name} at {speed_kph:g} km/h"
+    intro = (f"Linear yaw-plane model of `{vehicle.name}` ({vehicle.n_units} units: {', '.join(vehicle.unit_names)})"
+             f"{' from ' + source if source else ''}, assessed at {speed_kph:g} km/h with `lcvreport` "
+             "(SI units; speeds in km/h).")
+    nb = merge([("assessment", "assessment", title, path)], title, intro)
+    out = {"html": export_html(nb, out_dir), "data": data_dir}
+    progress("html written")
+    if pdf:
+        out["pdf"] = export_pdf(nb, out_dir, f"lcvreport assessment of {vehicle.name}")
+        progress("pdf written")
+    out["seconds"] = time.perf_counter() - t0
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry of ``./build.sh report``: the thesis report."""
+    p = argparse.ArgumentParser(description="Execute the thesis notebooks and build <build>/report/{index.html,"
+                                            "report.pdf,data/}.")
+    p.add_argument("--build-dir", type=Path, default=Path("build"))
+    p.add_argument("--fast", action="store_true", help="coarse time grids (tests)")
+    p.add_argument("--no-pdf", action="store_true", help="skip the PDF")
+    p.add_argument("--only", nargs="*", help="notebook stems to run (default all)")
+    p.add_argument("--notebooks", type=Path, default=None, help="another notebook folder (tests)")
+    args = p.parse_args(argv)
+    t0 = time.perf_counter()
+    try:
+        out = build(args.build_dir, fast=args.fast, pdf=not args.no_pdf, only=args.only,
+                    notebook_folder=args.notebooks, progress=lambda text: print(f"report: {text}", flush=True))
+    except ReportError as exc:
+        print(f"report: error: {exc}", file=sys.stderr)
+        return 1
+    for key in ("html", "pdf", "data"):
+        if key in out:
+            print(f"report: wrote {out[key]}")
+    print(f"report: {time.perf_counter() - t0:.1f} s (notebooks {out['seconds_execute']:.1f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,570 @@
+"""Figures: the vehicle seen from above, eigenvalue maps and root loci, time responses,
+frequency responses, study charts, tire curves.  Plotting only; every number comes
+from the analysis modules.
+
+Conventions of the top views: x forward to the right, y toward the curb drawn
+downward (the y axis is inverted), lengths to scale, in the display unit ``unit``
+(``"m"`` for the assessment report, ``"in"`` for the thesis' figures).  Functions
+return a :class:`matplotlib.figure.Figure` (no pyplot state); axis labels carry units;
+the smallest text is 7 pt at the figure's own size, so figures are made at the width
+they are printed at (:data:`PAGE_WIDTH_IN`).
+"""
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import FancyArrowPatch, Polygon
+
+from ..analysis.geometry import rear_offsets
+from ..analysis.modes import Modes
+from ..model.vehicle import Vehicle, joint_letter
+from ..units import M_PER_IN
+
+#: colours per run, stable order
+PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#7f7f7f",
+           "#bcbd22")
+BODY = {"tractor": "#4a6fa5", "trailer": "#b0b7c3", "dolly": "#6b6b6b"}
+#: text width of the PDF report [in] (figures are made this wide, so text prints at its size)
+PAGE_WIDTH_IN = 6.2
+#: smallest font size used anywhere [pt]
+SMALL_PT = 7.0
+#: drawing dimensions [m] (drawing only; the yaw-plane model has no widths): 72 in track,
+#: 102 in body width (the trailer width quoted in chapter V), 96 in cab, 30 in front overhang
+TRACK_WIDTH_M = 72 * M_PER_IN
+BODY_WIDTH_M = 102 * M_PER_IN
+CAB_WIDTH_M = 96 * M_PER_IN
+FRONT_OVERHANG_M = 30 * M_PER_IN
+#: a unit shorter than this from its front coupling to its rearmost point is drawn as a dolly [m]
+DOLLY_LENGTH_M = 3.0
+#: display units of lengths: metres per display unit
+LENGTH_UNITS = {"m": 1.0, "in": M_PER_IN}
+
+
+def new_figure(width: float = PAGE_WIDTH_IN, height: float = 3.6, ncols: int = 1, nrows: int = 1, **kw):
+    """A figure and its axes (not registered with pyplot: no global state)."""
+    fig = Figure(figsize=(width, height), layout="constrained")
+    axes = fig.subplots(nrows, ncols, squeeze=True, **kw)
+    return fig, axes
+
+
+# ------------------------------------------------------------------ top views
+def unit_kind(vehicle: Vehicle, k: int) -> str:
+    """``tractor`` (first unit), ``dolly`` (short coupled unit) or ``trailer``: how a unit is drawn."""
+    if k == 0:
+        return "tractor"
+    u = vehicle.units[k]
+    rear = min(vehicle.rear_end_x_m(k), u.rearmost_axle.x_m)
+    return "dolly" if u.front_coupling_m - rear < DOLLY_LENGTH_M else "trailer"
+
+
+def unit_poses(vehicle: Vehicle, theta: np.ndarray | None = None) -> list[tuple[np.ndarray, float]]:
+    """CG position [m] and heading [rad] of every unit, first unit's CG at the origin heading +x.
+
+    ``theta`` are the articulation angles [rad]; headings follow psi_(k+1) = psi_k - theta_k.
+    """
+    theta = np.zeros(vehicle.n_units - 1) if theta is None else np.asarray(theta, dtype=float)
+    poses = []
+    for k, unit in enumerate(vehicle.units):
+        if k == 0:
+            cg, psi = np.zeros(2), 0.0
+        else:
+            prev_cg, prev_psi = poses[-1]
+            joint = prev_cg + vehicle.units[k - 1].rear_coupling_m * _dir(prev_psi)
+            psi = prev_psi - theta[k - 1]
+            cg = joint - unit.front_coupling_m * _dir(psi)
+        poses.append((cg.copy(), psi))
+    return poses
+
+
+def _dir(psi: float) -> np.ndarray:
+    return np.array([np.cos(psi), np.sin(psi)])
+
+
+def _rect(center: np.ndarray, psi: float, front: float, rear: float, half_width: float) -> np.ndarray:
+    d = _dir(psi)
+    n = np.array([-d[1], d[0]])
+    return np.array([center + front * d + half_width * n, center + front * d - half_width * n,
+                     center + rear * d - half_width * n, center + rear * d + half_width * n])
+
+
+def body_extent(vehicle: Vehicle, k: int) -> tuple[float, float, float]:
+    """(front x, rear x, half width) of the drawn body of unit ``k`` [m, signed x from its CG]."""
+    u = vehicle.units[k]
+    xs = [a.x_m for a in u.axles]
+    kind = unit_kind(vehicle, k)
+    if kind == "tractor":
+        rear = min(min(xs) - 0.61, u.rear_coupling_m - 0.3 if u.rear_coupling_m is not None else np.inf)
+        if u.rear_end_m is not None:
+            rear = min(rear, u.rear_end_m)
+        return max(xs) + FRONT_OVERHANG_M, rear, CAB_WIDTH_M / 2
+    if kind == "dolly":
+        return u.front_coupling_m, min(min(xs), vehicle.rear_end_x_m(k)) - 0.61, TRACK_WIDTH_M / 2 + 0.15
+    return u.front_coupling_m + 0.76, min(vehicle.rear_end_x_m(k), min(xs) - 0.6), BODY_WIDTH_M / 2
+
+
+def draw_unit(ax, vehicle: Vehicle, k: int, cg: np.ndarray, psi: float, alpha: float = 1.0, labels: bool = True,
+              tires: bool = True, outline_only: bool = False, unit: str = "m") -> None:
+    """Draw unit ``k`` (0-based) of ``vehicle`` with its CG at ``cg`` [m] and heading ``psi`` [rad]."""
+    f = 1.0 / LENGTH_UNITS[unit]
+    u = vehicle.units[k]
+    kind = unit_kind(vehicle, k)
+    front, rear, hw = body_extent(vehicle, k)
+    ax.add_patch(Polygon(f * _rect(cg, psi, front, rear, hw), closed=True, alpha=alpha,
+                         facecolor="none" if outline_only else BODY[kind], edgecolor="black", lw=0.8))
+    if tires:
+        nrm = np.array([-np.sin(psi), np.cos(psi)])
+        for a in u.axles:
+            centre = cg + a.x_m * _dir(psi)
+            per_side = max(a.tires // 2, 1)
+            D = a.dual_spacing_m
+            offs = [TRACK_WIDTH_M / 2] if per_side == 1 else [TRACK_WIDTH_M / 2 - D / 2 + D * j / (per_side - 1)
+                                                              for j in range(per_side)]
+            for side in (1, -1):
+                for o in offs:
+                    ax.add_patch(Polygon(f * _rect(centre + side * o * nrm, psi, 0.5, -0.5, 0.11), closed=True,
+                                         facecolor="black", alpha=alpha, lw=0))
+            a_end = centre + (TRACK_WIDTH_M / 2 + D) * nrm
+            b_end = centre - (TRACK_WIDTH_M / 2 + D) * nrm
+            ax.plot(f * np.array([a_end[0], b_end[0]]), f * np.array([a_end[1], b_end[1]]), color="black",
+                    lw=0.8, alpha=alpha)
+    if k > 0:
+        j = f * (cg + u.front_coupling_m * _dir(psi))
+        ax.plot(j[0], j[1], "o", ms=4, color="white", mec="black", alpha=alpha, zorder=5)
+        if labels:
+            ax.annotate(joint_letter(k - 1), j, xytext=(0, -12), textcoords="offset points", ha="center",
+                        fontsize=SMALL_PT, alpha=alpha)
+    if labels:
+        ax.annotate(f"{k + 1}", f * cg, ha="center", va="center", fontsize=8, fontweight="bold", alpha=alpha,
+                    color="white" if kind != "trailer" else "black")
+
+
+def draw_vehicle(ax, vehicle: Vehicle, theta: np.ndarray | None = None, alpha: float = 1.0, labels: bool = True,
+                 tires: bool = True, outline_only: bool = False, unit: str = "m") -> list:
+    """Draw ``vehicle`` from above on ``ax`` to scale in the display ``unit`` ("m" or "in").
+
+    Returns the unit poses used (CG position [m], heading [rad]).
+    """
+    poses = unit_poses(vehicle, theta)
+    for k, (cg, psi) in enumerate(poses):
+        draw_unit(ax, vehicle, k, cg, psi, alpha, labels, tires, outline_only, unit)
+    return poses
+
+
+def _top_view_axes(ax, unit: str, ylim_m: float | None = None):
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"x, forward [{unit}]")
+    ax.set_ylabel(f"y, toward the curb [{unit}]")
+    ax.autoscale_view()
+    if ylim_m is not None:
+        f = 1.0 / LENGTH_UNITS[unit]
+        ax.set_ylim(ylim_m * f, -ylim_m * f)
+    else:
+        ax.invert_yaxis()
+
+
+def fig_combinations(vehicles: list[tuple[str, Vehicle]], unit: str = "m") -> Figure:
+    """Vehicle combinations drawn to scale, one per row (Figure 1-2)."""
+    fig, axes = new_figure(PAGE_WIDTH_IN, 1.5 * len(vehicles), nrows=len(vehicles), sharex=True)
+    for ax, (label, v) in zip(np.atleast_1d(axes), vehicles):
+        draw_vehicle(ax, v, unit=unit)
+        ax.set_title(label, fontsize=8, loc="left")
+        _top_view_axes(ax, unit, ylim_m=2.3)
+    return fig
+
+
+def fig_vehicle(vehicle: Vehicle, title: str) -> Figure:
+    """The vehicle to scale from its file, with the couplings, axles and CGs marked [m]."""
+    poses = unit_poses(vehicle)
+    length = -min(cg[0] + body_extent(vehicle, k)[1] for k, (cg, _p) in enumerate(poses))
+    fig, ax = new_figure(PAGE_WIDTH_IN, 2.4)
+    draw_vehicle(ax, vehicle)
+    for k, (cg, _psi) in enumerate(poses):
+        ax.plot(cg[0], cg[1], "+", color="red", ms=6, zorder=6)
+    ax.set_title(f"{title} (to scale; + CG, o coupling; overall about {length + FRONT_OVERHANG_M:.1f} m)",
+                 fontsize=8)
+    _top_view_axes(ax, "m", ylim_m=2.6)
+    return fig
+
+
+def fig_mode_shape(vehicle: Vehicle, modes: Modes, index: int, title: str, max_angle_deg: float = 6.0,
+                   unit: str = "m") -> Figure:
+    """A mode shape seen from above: the articulation angles of mode ``index`` at
+    phases 0, 90, 180 and 270 degrees, scaled so the largest angle is ``max_angle_deg``;
+    the first unit's own motion is left out, as in the thesis.  A single unit has no
+    articulation: its drawing is the straight vehicle with the mode in the title."""
+    n = vehicle.n_units
+    X = modes.shapes[:, index]
+    th = X[n + 1:2 * n]
+    fig, ax = new_figure(PAGE_WIDTH_IN, 2.3)
+    if th.size and np.abs(th).max() > 0:
+        scale = np.radians(max_angle_deg) / np.abs(th).max()
+        for phase, alpha in ((0, 1.0), (90, 0.45), (180, 0.3), (270, 0.45)):
+            theta = (th * scale * np.exp(1j * np.radians(phase))).real
+            draw_vehicle(ax, vehicle, theta, alpha=alpha, labels=phase == 0, tires=phase == 0,
+                         outline_only=phase != 0, unit=unit)
+    else:
+        draw_vehicle(ax, vehicle, unit=unit)
+    lam = modes.eigenvalues[index]
+    ax.set_title(f"{title}: lambda = {lam.real:.3f} {'+' if lam.imag >= 0 else '-'} {abs(lam.imag):.3f}i 1/s, "
+                 f"f_d = {modes.damped_frequency_hz[index]:.3f} Hz, zeta = {modes.damping_ratio[index]:.3f}\n"
+                 f"(phases 0/90/180/270 deg, largest articulation {max_angle_deg:g} deg)", fontsize=SMALL_PT + 0.5)
+    _top_view_axes(ax, unit)
+    return fig
+
+
+def fig_load_configuration(vehicle: Vehicle, configuration: str, title: str, fraction: float = 0.01,
+                           unit: str = "in") -> Figure:
+    """Figures 3-6..3-8, 4-9..4-11: residual lateral force of every tire as an arrow
+    (red; dimmed where unchanged from the balanced configuration)."""
+    from ..thesis.configurations import tire_forces
+    f = 1.0 / LENGTH_UNITS[unit]
+    fig, ax = new_figure(PAGE_WIDTH_IN, 2.4)
+    poses = draw_vehicle(ax, vehicle, unit=unit)
+    balanced = {(t.axle, t.side, t.lateral_offset_m): t.force_N for t in tire_forces(vehicle, "balanced", fraction)}
+    forces = tire_forces(vehicle, configuration, fraction)
+    fmax = max(abs(t.force_N) for t in forces)
+    where = {a.name: i for i, u in enumerate(vehicle.units) for a in u.axles}
+    axles = {a.name: a for a in vehicle.axles}
+    for t in forces:
+        cg, psi = poses[where[t.axle]]
+        d = _dir(psi)
+        nrm = np.array([-d[1], d[0]])
+        start = cg + axles[t.axle].x_m * d + t.lateral_offset_m * nrm
+        end = start + np.sign(t.force_N) * (0.45 + 0.75 * abs(t.force_N) / fmax) * nrm
+        changed = configuration != "balanced" and balanced[(t.axle, t.side, t.lateral_offset_m)] != t.force_N
+        ax.add_patch(FancyArrowPatch(f * start, f * end, arrowstyle="-|>", mutation_scale=7, color="red",
+                                     alpha=1.0 if configuration == "balanced" or changed else 0.25, lw=1.0))
+    ax.set_title(f"{title} ({100 * fraction:g} % of each tire load along y)", fontsize=8)
+    _top_view_axes(ax, unit, ylim_m=2.8)
+    return fig
+
+
+def fig_free_body(vehicle: Vehicle, title: str, unit: str = "in") -> Figure:
+    """Figures 3-1 and 4-1: free-body diagrams seen from above: tire forces F_ij and
+    residual forces P_ij at the axles, joint forces at the joints, u, v_i, r_i at the CGs.
+    The units are pulled apart and drawn in two rows when there are more than two."""
+    f = 1.0 / LENGTH_UNITS[unit]
+    n = vehicle.n_units
+    rows = 1 if n <= 2 else 2
+    per_row = int(np.ceil(n / rows))
+    fig, axes = new_figure(PAGE_WIDTH_IN, 2.6 * rows, nrows=rows)
+    axes = np.atleast_1d(axes)
+    gap = 2.3
+    poses = unit_poses(vehicle)
+    for r, ax in enumerate(axes):
+        ks = range(r * per_row, min(n, (r + 1) * per_row))
+        if not len(ks):
+            continue
+        shift = -poses[ks[0]][0][0]
+        for k in ks:
+            u = vehicle.units[k]
+            cg = np.array([poses[k][0][0] + shift - gap * (k - ks[0]), 0.0])
+            draw_unit(ax, vehicle, k, cg, 0.0, labels=False, unit=unit)
+            ax.add_patch(FancyArrowPatch(f * cg, f * (cg + (1.1, 0)), arrowstyle="-|>", mutation_scale=7, color="#333"))
+            ax.add_patch(FancyArrowPatch(f * cg, f * (cg + (0, 0.95)), arrowstyle="-|>", mutation_scale=7,
+                                         color="#333"))
+            ax.annotate(f"u, v{k + 1}, r{k + 1}", f * cg, xytext=(4, 4), textcoords="offset points",
+                        fontsize=SMALL_PT)
+            for a in u.axles:
+                p = cg + (a.x_m, 0)
+                ax.add_patch(FancyArrowPatch(f * (p + (0, -2.0)), f * (p + (0, -1.2)), arrowstyle="-|>",
+                                             mutation_scale=7, color="blue"))
+                ax.annotate(f"F{a.name}, P{a.name}\nM{a.name}, T{a.name}", f * (p + (0, -2.05)), ha="center",
+                            fontsize=SMALL_PT, color="blue")
+            if k > 0:
+                p = cg + (u.front_coupling_m, 0)
+                ax.add_patch(FancyArrowPatch(f * (p + (0, 1.8)), f * (p + (0, 1.15)), arrowstyle="-|>",
+                                             mutation_scale=7, color="green"))
+                ax.annotate(f"F{joint_letter(k - 1)}", f * (p + (0, 2.05)), ha="center", fontsize=SMALL_PT,
+                            color="green")
+            if k < n - 1:
+                p = cg + (u.rear_coupling_m, 0)
+                ax.add_patch(FancyArrowPatch(f * (p + (0, 1.15)), f * (p + (0, 1.8)), arrowstyle="-|>",
+                                             mutation_scale=7, color="green"))
+                ax.annotate(f"F{joint_letter(k)}", f * (p + (0, 2.05)), ha="center", fontsize=SMALL_PT,
+                            color="green")
+        _top_view_axes(ax, unit, ylim_m=2.6)
+    axes[0].set_title(title, fontsize=8)
+    return fig
+
+
+def fig_steady_state_top_view(vehicle: Vehicle, x_ss: np.ndarray, title: str, exaggerate: float,
+                              unit: str = "m") -> Figure:
+    """Steady state seen from above with the articulation angles multiplied by
+    ``exaggerate`` (Figure 2-10: dog-tracking); the straight-ahead pose is dimmed."""
+    n = vehicle.n_units
+    fig, ax = new_figure(PAGE_WIDTH_IN, 2.4)
+    draw_vehicle(ax, vehicle, alpha=0.25, labels=False, outline_only=True, unit=unit)
+    draw_vehicle(ax, vehicle, x_ss[n + 1:2 * n] * exaggerate, unit=unit)
+    y = rear_offsets(vehicle, x_ss[n + 1:2 * n]) / LENGTH_UNITS[unit]
+    ax.set_title(f"{title}: rear end of unit {n} offset {y[-1]:.3f} {unit} from the tractor axis "
+                 f"(angles drawn x{exaggerate:g})", fontsize=8)
+    _top_view_axes(ax, unit)
+    return fig
+
+
+# ------------------------------------------------------------------ eigenvalues
+def fig_eigenvalues(sets: list[tuple[str, np.ndarray]], title: str, upper: bool = False,
+                    connect_mode: int | None = None) -> Figure:
+    """Eigenvalue map(s): real part [1/s] against imaginary part [1/s].
+
+    ``upper`` shows only the upper-left quadrant; ``connect_mode`` (1-based, mode
+    order of :func:`lcvreport.analysis.modes.mode_order`) joins that mode across the
+    sets with a dashed black line, as the thesis does for Mode 7.
+    """
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.6)
+    markers = "osD^v<>ph"
+    for i, (label, lam) in enumerate(sets):
+        ax.scatter(lam.real, lam.imag, s=18, marker=markers[i % len(markers)], color=PALETTE[i % len(PALETTE)],
+                   label=label, zorder=3)
+    if connect_mode is not None:
+        pts = np.array([lam[connect_mode - 1] for _, lam in sets])
+        ax.plot(pts.real, pts.imag, "k--", lw=1, label=f"Mode {connect_mode}")
+    ax.axvline(0, color="black", lw=0.8)
+    ax.axhline(0, color="black", lw=0.5)
+    if upper:
+        ax.set_xlim(right=0)
+        ax.set_ylim(bottom=0)
+    ax.set_xlabel("Re(lambda) [1/s]")
+    ax.set_ylabel("Im(lambda) [1/s]")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT)
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
+def fig_root_locus(speeds_kph: np.ndarray, eigenvalues: np.ndarray, title: str,
+                   critical_kph: float | None = None) -> Figure:
+    """Root locus over speed: every eigenvalue [1/s] coloured by the speed [km/h]."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.8)
+    sc = None
+    for j in range(eigenvalues.shape[1]):
+        sc = ax.scatter(eigenvalues[:, j].real, eigenvalues[:, j].imag, c=speeds_kph, cmap="viridis", s=6,
+                        zorder=3, label="_nolegend_" if j else "eigenvalues")
+    cb = fig.colorbar(sc, ax=ax)
+    cb.set_label("speed [km/h]", fontsize=8)
+    cb.ax.tick_params(labelsize=SMALL_PT)
+    ax.axvline(0, color="black", lw=0.8)
+    ax.axhline(0, color="black", lw=0.5)
+    note = "stable throughout" if critical_kph is None else f"critical speed {critical_kph:.1f} km/h"
+    ax.set_xlabel("Re(lambda) [1/s]")
+    ax.set_ylabel("Im(lambda) [1/s]")
+    ax.grid(True, lw=0.3)
+    ax.set_title(f"{title} ({note})", fontsize=9)
+    return fig
+
+
+def fig_damping_over_speed(speeds_kph: np.ndarray, zeta: np.ndarray, max_real: np.ndarray, title: str,
+                           critical_kph: float | None, speed_kph: float | None = None) -> Figure:
+    """Least damping ratio [-] and largest real part [1/s] against speed [km/h]."""
+    fig, (a1, a2) = new_figure(PAGE_WIDTH_IN, 3.8, nrows=2, sharex=True)
+    a1.plot(speeds_kph, zeta, color=PALETTE[0])
+    a1.set_ylabel("least damping ratio [-]")
+    a2.plot(speeds_kph, max_real, color=PALETTE[1])
+    a2.axhline(0, color="black", lw=0.8)
+    a2.set_ylabel("max Re(lambda) [1/s]")
+    a2.set_xlabel("speed [km/h]")
+    for ax in (a1, a2):
+        ax.grid(True, lw=0.3)
+        if critical_kph is not None:
+            ax.axvline(critical_kph, color="red", ls="--", lw=1)
+        if speed_kph is not None:
+            ax.axvline(speed_kph, color="black", ls=":", lw=1)
+    note = "stable throughout" if critical_kph is None else f"critical speed {critical_kph:.1f} km/h (red)"
+    a1.set_title(f"{title}: {note}" + ("; dotted: the report's speed" if speed_kph is not None else ""), fontsize=9)
+    return fig
+
+
+# ------------------------------------------------------------------ time and frequency
+def fig_time(series: list[tuple[str, np.ndarray, np.ndarray, dict]], ylabel: str, title: str,
+             hlines: list[tuple[str, float]] = (), xlim: tuple | None = None, annotate_peaks: bool = False,
+             height: float = 3.4) -> Figure:
+    """Time histories: ``series`` of (label, time [s], values, line style keywords)."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, height)
+    for i, (label, t, y, style) in enumerate(series):
+        kw = {"color": PALETTE[i % len(PALETTE)], "lw": 1.1}
+        kw.update(style)
+        ax.plot(t, y, label=label, **kw)
+        if annotate_peaks:
+            mask = np.ones_like(t, dtype=bool) if xlim is None else (t >= xlim[0]) & (t <= xlim[1])
+            k = int(np.argmax(np.abs(np.where(mask, y, 0))))
+            ax.annotate(f"{y[k]:.3f}", (t[k], y[k]), fontsize=SMALL_PT, color=kw["color"], xytext=(2, 2),
+                        textcoords="offset points")
+    for label, value in hlines:
+        ax.axhline(value, color="black", ls=":", lw=1)
+        ax.annotate(label, (1.0, value), xycoords=("axes fraction", "data"), ha="right", va="bottom",
+                    fontsize=SMALL_PT)
+    if xlim is not None:
+        ax.set_xlim(*xlim)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3)
+    if series:
+        ax.legend(fontsize=SMALL_PT, ncol=2)
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
+def plot_time_response(response, signals=None, ax=None, **style) -> Figure:
+    """Signals of a :class:`lcvreport.analysis.response.TimeResponse` against time."""
+    names = signals or [f"y{k}" for k in range(2, response.vehicle.n_units + 1)] or ["Y1"]
+    if ax is None:
+        fig, ax = new_figure(PAGE_WIDTH_IN, 3.2)
+    else:
+        fig = ax.figure
+    units = {"v": "m/s", "r": "rad/s", "t": "rad", "y": "m", "Y": "m", "a": "m/s^2", "p": "rad"}
+    for i, name in enumerate(names):
+        kw = {"color": PALETTE[i % len(PALETTE)], "lw": 1.1}
+        kw.update(style)
+        ax.plot(response.time, response[name], label=f"{name} [{units.get(name[0], '')}]", **kw)
+    ax.set_xlabel("time [s]")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT, ncol=2)
+    if response.label:
+        ax.set_title(response.label, fontsize=9)
+    return fig
+
+
+def plot_single_sine(ss, ax=None) -> Figure:
+    """Lateral accelerations [m/s^2] of every unit in a single-sine manoeuvre, and the steer angle."""
+    if ax is None:
+        fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
+    else:
+        fig = ax.figure
+    names = ss.vehicle.unit_names if ss.vehicle is not None else [f"unit {i + 1}" for i in range(ss.ay.shape[1])]
+    for i in range(ss.ay.shape[1]):
+        ax.plot(ss.time, ss.ay[:, i], color=PALETTE[i % len(PALETTE)], lw=1.0,
+                label=f"a{i + 1} {names[i]} (peak {ss.peaks[i]:.3g})")
+    ax2 = ax.twinx()
+    ax2.plot(ss.time, np.degrees(ss.delta), color="black", lw=0.8, ls=":", label="steer angle")
+    ax2.set_ylabel("steer angle [deg] (dotted)")
+    ax2.tick_params(labelsize=SMALL_PT)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("lateral acceleration [m/s^2]")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT, ncol=2, loc="lower right")
+    return fig
+
+
+def fig_frequency(f_hz: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: str, title: str,
+                  mark_hz: float | None = None, logy: bool = False) -> Figure:
+    """Curves against frequency [Hz] (RA(f), gains)."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.2)
+    for i, (label, y) in enumerate(curves):
+        ax.plot(f_hz, y, color=PALETTE[i % len(PALETTE)], lw=1.1, label=label)
+    if mark_hz is not None:
+        ax.axvline(mark_hz, color="black", ls=":", lw=1)
+    if logy:
+        ax.set_yscale("log")
+    ax.set_xlabel("steer frequency [Hz]")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3, which="both")
+    ax.legend(fontsize=SMALL_PT, ncol=2)
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
+def fig_bars(labels: list[str], groups: list[tuple[str, np.ndarray]], ylabel: str, title: str,
+             height: float = 3.6) -> Figure:
+    """Grouped bar chart (Figures 5-4, 5-8, 5-13, 5-18, 5-20; conicity sensitivity)."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, height)
+    x = np.arange(len(labels))
+    w = 0.8 / len(groups)
+    for i, (glabel, values) in enumerate(groups):
+        bars = ax.bar(x + (i - (len(groups) - 1) / 2) * w, values, w, label=glabel, color=PALETTE[i])
+        for b, v in zip(bars, values):
+            ax.annotate(f"{v:.3g}", (b.get_x() + b.get_width() / 2, b.get_height()), ha="center",
+                        va="bottom" if v >= 0 else "top", fontsize=SMALL_PT)
+    ax.set_xticks(x, labels, rotation=25, ha="right", fontsize=SMALL_PT)
+    ax.axhline(0, color="black", lw=0.6)
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=SMALL_PT)
+    ax.grid(True, axis="y", lw=0.3)
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
+def fig_fit(x: np.ndarray, ys: list[tuple[str, np.ndarray]], degree: int | None, xlabel: str, ylabel: str,
+            title: str) -> Figure:
+    """Points and (optional) least-squares polynomial fits of the given degree."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
+    xx = np.linspace(np.min(x), np.max(x), 101)
+    for i, (label, y) in enumerate(ys):
+        ax.plot(x, y, "o", color=PALETTE[i], label=label)
+        if degree is not None:
+            c = np.polyfit(x, y, degree)
+            ax.plot(xx, np.polyval(c, xx), "--", color=PALETTE[i], lw=1, label=f"degree-{degree} fit")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT)
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
+# ------------------------------------------------------------------ tires (thesis, inch-pound units)
+def fig_tire_vs_slip(quantity: str, loads_lbf: tuple[float, ...], title: str, residual_lbf: float = 0.0) -> Figure:
+    """Figures 2-5, 2-6, 2-8: the linear tire model against slip angle for several
+    vertical loads, per tire: lateral force F = CF alpha [lbf] or aligning moment
+    -CM alpha [lbf*in]; ``residual_lbf`` shifts the force curves (Figure 2-8)."""
+    from ..thesis.tires import tire_fit
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
+    fit = tire_fit()
+    alpha_deg = np.linspace(-2.0, 2.0, 81)
+    alpha = np.radians(alpha_deg)
+    for i, w in enumerate(loads_lbf):
+        cf, cm, _cs = fit.evaluate(w)
+        y = cf * alpha + residual_lbf if quantity == "force" else -cm * alpha
+        ax.plot(alpha_deg, y, color=PALETTE[i], label=f"tire load {w:.0f} lbf")
+    if residual_lbf:
+        ax.annotate(f"residual force {residual_lbf:g} lbf at zero slip", (0, residual_lbf), xytext=(10, -25),
+                    textcoords="offset points", fontsize=SMALL_PT, arrowprops=dict(arrowstyle="->"))
+    ax.axhline(0, color="black", lw=0.6)
+    ax.axvline(0, color="black", lw=0.6)
+    ax.set_xlabel("slip angle alpha [deg]")
+    ax.set_ylabel("lateral force per tire [lbf]" if quantity == "force" else "aligning moment per tire [lbf*in]")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT)
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
+def fig_tire_fit(key: str, ylabel: str, title: str) -> Figure:
+    """Figures D.1-D.3: per-tire coefficient against tire load, the Table D points and the cubic fit."""
+    from ..thesis.tires import tire_fit
+    fit = tire_fit()
+    pts = fit.points[key]
+    coef = getattr(fit, key)
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
+    w = np.linspace(pts[:, 0].min(), pts[:, 0].max(), 201)
+    ax.plot(pts[:, 0], pts[:, 1], "o", color=PALETTE[0], label="Tables D.1-D.5")
+    ax.plot(w, np.polyval(coef, w), "-", color=PALETTE[1],
+            label="cubic fit: " + " + ".join(f"{c:.4g} W^{3 - k}" for k, c in enumerate(coef)))
+    ax.set_xlabel("vertical tire load W [lbf]")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT)
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
+def figure_data(fig: Figure) -> list[dict]:
+    """The numbers a figure shows (lines, markers, bars, patches), for CSV export and diffing."""
+    rows = []
+    for ia, ax in enumerate(fig.axes):
+        for il, line in enumerate(ax.get_lines()):
+            for x, y in line.get_xydata():
+                rows.append({"axes": ia, "artist": f"line{il}", "label": line.get_label(), "x": float(x), "y": float(y)})
+        for ic, coll in enumerate(ax.collections):
+            for x, y in np.asarray(coll.get_offsets()):
+                rows.append({"axes": ia, "artist": f"points{ic}", "label": coll.get_label(), "x": float(x),
+                             "y": float(y)})
+        for ib, cont in enumerate(ax.containers):
+            for bar in cont:
+                rows.append({"axes": ia, "artist": f"bars{ib}", "label": cont.get_label(),
+                             "x": float(bar.get_x() + bar.get_width() / 2), "y": float(bar.get_height())})
+        for ip, patch in enumerate(ax.patches):
+            if isinstance(patch, Polygon):
+                for x, y in patch.get_xy():
+                    rows.append({"axes": ia, "artist": f"polygon{ip}", "label": "", "x": float(x), "y": float(y)})
+    return rows
