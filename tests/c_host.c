@@ -243,6 +243,7 @@ int main(int argc, char **argv)
     }
     terminate(c);
     freeinst(c);
+    dlclose(lib);
     printf("done\n");
     fflush(stdout);
     return 0;

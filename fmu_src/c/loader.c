@@ -46,6 +46,20 @@ FORWARDED(DECLARE)
 
 static pthread_once_t once = PTHREAD_ONCE_INIT;
 static char load_error[2048];
+wchar_t *lcv_loader_python_home;   /* Py_SetPythonHome keeps the pointer: it lives as long as the process */
+static void (*p_finalizePythonInterpreter)(void);
+
+/* pythonfmu 0.7.0 keeps its interpreter state in a static std::shared_ptr, destroyed by a
+   C++ static destructor at exit; its library destructor (finalizePythonInterpreter) then
+   assigns to the destroyed pointer -- a use after free (valgrind: "Invalid read ... in
+   finalizePythonInterpreter ... block free'd in __run_exit_handlers") that corrupts the
+   heap and aborts the host at exit ("free(): corrupted unsorted chunks").  Releasing the
+   state before the static destructors run (atexit handlers run in reverse order of
+   registration, and this one is registered after pythonfmu's) leaves nothing to free twice. */
+static void release_pythonfmu(void)
+{
+    if (p_finalizePythonInterpreter) p_finalizePythonInterpreter();
+}
 
 typedef struct {
     fmi2Component inner;
@@ -124,9 +138,8 @@ static void bring_up(void)
             return;
         }
         if (set_home && decode && home && *home) {
-            static wchar_t *whome;   /* must outlive the interpreter */
-            whome = decode(home, NULL);
-            if (whome) set_home(whome);
+            lcv_loader_python_home = decode(home, NULL);
+            if (lcv_loader_python_home) set_home(lcv_loader_python_home);
         }
         init(0);                     /* 0: leave the host's signal handlers alone */
         (void)save();                /* release the GIL; pythonfmu takes it per call */
@@ -167,6 +180,8 @@ static void bring_up(void)
         snprintf(load_error, sizeof load_error, "%s lacks %s", path, #F); return; }
     FORWARDED(RESOLVE)
 #undef RESOLVE
+    *(void **)&p_finalizePythonInterpreter = dlsym(lib, "finalizePythonInterpreter");
+    if (p_finalizePythonInterpreter) atexit(release_pythonfmu);
 }
 
 /* ------------------------------------------------------------------ logging */
@@ -455,9 +470,11 @@ fmi2Status fmi2CancelStep(fmi2Component c)
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
 {
+    (void)s;   /* steps are synchronous: the status of the last one is what doStep returned */
     Wrapper *w = (Wrapper *)c;
     if (!usable(w, "fmi2GetStatus") || !value) return fmi2Error;
-    return outcome(w, p_fmi2GetStatus(w->inner, s, value), "fmi2GetStatus");
+    *value = fmi2OK;
+    return fmi2OK;
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)

@@ -211,7 +211,9 @@ static const double *step_matrix(ModelInstance *c, double u, double h)
 }
 
 /* ------------------------------------------------------------------ inputs and steps */
-static int check_inputs(ModelInstance *c)
+/* the first input that is not finite or out of range (with the speed: above its maximum)
+   into c->msg; -1 if there is one */
+static int check_inputs_(ModelInstance *c, int speed)
 {
     for (int k = 0; k < LCV_N_INPUTS; ++k) {
         double x = c->s.w[k];
@@ -224,7 +226,7 @@ static int check_inputs(ModelInstance *c)
         double lim = 0.0;
         switch (LCV_INPUT_KIND[k]) {
         case LCV_IN_SPEED:
-            if (x > LCV_SPEED_MAX) {
+            if (speed && x > LCV_SPEED_MAX) {
                 snprintf(c->msg, sizeof c->msg, "input u = %.6g m/s is above %.4g m/s, the fastest speed the model "
                          "is run at; the step is refused and the state is unchanged", x, LCV_SPEED_MAX);
                 return -1;
@@ -242,6 +244,8 @@ static int check_inputs(ModelInstance *c)
     }
     return 0;
 }
+
+static int check_inputs(ModelInstance *c) { return check_inputs_(c, 1); }
 
 int model_do_step(ModelInstance *c, double h)
 {
@@ -297,10 +301,13 @@ static double output_speed(const ModelInstance *c)
     return c->s.last_speed;
 }
 
-static int compute_outputs(ModelInstance *c, double *out)
+/* every output into out[]; valid[o] = 0 where an output cannot be evaluated (c->msg says why) */
+static void compute_outputs(ModelInstance *c, double *out, int *valid)
 {
     const LcvVehicle *v = vehicle_of(c);
     int n = v->n, m = n + 2, N = v->n_units;
+    char why[1024] = "";
+    int inputs_ok = -1;
     double theta_sin[LCV_MAX_UNITS];
     for (int k = 0; k < N - 1; ++k) {
         double s = 0.0;
@@ -311,6 +318,7 @@ static int compute_outputs(ModelInstance *c, double *out)
     SpeedEntry *se = NULL;
     for (int o = 0; o < LCV_N_OUTPUTS; ++o) {
         double s = 0.0;
+        valid[o] = 1;
         switch (LCV_OUTPUT_KIND[o]) {
         case LCV_OUT_LINEAR:
             for (int j = 0; j < m; ++j) s += v->C[(size_t)o * m + j] * c->s.z[j];
@@ -321,9 +329,15 @@ static int compute_outputs(ModelInstance *c, double *out)
         case LCV_OUT_ACCEL: {
             int i = v->ay_unit[o];
             if (i < 0) break;
+            if (inputs_ok < 0) {
+                inputs_ok = check_inputs_(c, 0) == 0;
+                if (!inputs_ok) snprintf(why, sizeof why, "the lateral accelerations depend on the inputs: %.900s", c->msg);
+            }
+            if (!inputs_ok) { valid[o] = 0; break; }
             if (!se && !(se = speed_entry(c, u))) {
-                snprintf(c->msg, sizeof c->msg, "the lateral accelerations cannot be evaluated at u = %.6g m/s", u);
-                return -1;
+                snprintf(why, sizeof why, "the lateral accelerations cannot be evaluated at u = %.6g m/s", u);
+                valid[o] = 0;
+                break;
             }
             for (int j = 0; j < n; ++j) s += se->Ca[(size_t)i * n + j] * c->s.z[j];
             for (int j = 0; j < LCV_N_INPUTS; ++j) s += se->DaB[(size_t)i * LCV_N_INPUTS + j] * c->s.w[j];
@@ -331,23 +345,24 @@ static int compute_outputs(ModelInstance *c, double *out)
         }
         default:
             if (max_real_eig(c, u, &s) != 0) {
-                snprintf(c->msg, sizeof c->msg, "the eigenvalues at u = %.6g m/s did not converge", u);
-                return -1;
+                snprintf(why, sizeof why, "the eigenvalues at u = %.6g m/s did not converge", u);
+                valid[o] = 0;
             }
             break;
         }
-        if (!isfinite(s)) {
-            snprintf(c->msg, sizeof c->msg, "output %s is not finite", LCV_VARIABLE_NAMES[LCV_FIRST_OUTPUT + o]);
-            return -1;
+        if (valid[o] && !isfinite(s)) {
+            snprintf(why, sizeof why, "output %s is not finite", LCV_VARIABLE_NAMES[LCV_FIRST_OUTPUT + o]);
+            valid[o] = 0;
         }
-        out[o] = s;
+        out[o] = valid[o] ? s : 0.0;
     }
-    return 0;
+    if (why[0]) snprintf(c->msg, sizeof c->msg, "%s", why);
 }
 
 int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, double value[])
 {
     double out[LCV_N_OUTPUTS];
+    int valid[LCV_N_OUTPUTS];
     int have = 0, status = 0;
     for (size_t i = 0; i < nvr; ++i) {
         unsigned r = vr[i];
@@ -362,10 +377,11 @@ int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, 
             value[i] = 0.0;
             if (c->s.vehicle < 0) continue;                /* before initialization: at rest */
             if (!have) {
-                if (compute_outputs(c, out) != 0) { status = -1; continue; }
+                compute_outputs(c, out, valid);
                 have = 1;
             }
             value[i] = out[r - LCV_FIRST_OUTPUT];
+            if (!valid[r - LCV_FIRST_OUTPUT]) status = -1;
         } else {
             value[i] = 0.0;
             snprintf(c->msg, sizeof c->msg, "fmi2GetReal: %u is not the value reference of a Real variable", r);

@@ -301,6 +301,8 @@ def build_native_fmu(itf: Interface, out_dir: Path, model_identifier: str, stub:
             for name, text in generated.items():
                 files[f"sources/{name}"] = text.encode()
             files["sources/README.txt"] = SOURCES_README.format(identifier=model_identifier).encode()
+            if not itf.preset_mode:   # the vehicle built in, as its file (for the user; the C code does not read it)
+                files["resources/vehicle.toml"] = dumps_vehicle(itf.vehicles[0]).encode()
         return _zip(out_dir / f"{model_identifier}.fmu", files)
 
 
@@ -309,7 +311,7 @@ def _package_copy(dst: Path) -> None:
     import lcvreport
     pkg = Path(lcvreport.__file__).resolve().parent
     shutil.copytree(pkg, dst / "lcvreport", ignore=shutil.ignore_patterns(
-        "__pycache__", "*.pyc", "fmu_src", "notebooks", "report", "thesis", "cli.py", "build.py"))
+        "__pycache__", "*.pyc", "fmu_src", "notebooks", "report", "thesis", "cli.py", "build.py", "data/thesis"))
 
 
 def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: dict | None = None) -> Path:

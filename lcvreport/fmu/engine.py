@@ -189,26 +189,33 @@ class LCVEngine:
         """The speed the model runs at for an input ``u`` [m/s] (clamped to u_min)."""
         return max(u, self.u_min)
 
-    def check_inputs(self, w: np.ndarray) -> None:
-        """Raise :class:`CosimError` naming the first input that is not finite or out of range."""
+    def input_problem(self, w, speed: bool = True) -> CosimError | None:
+        """The first input that is not finite or out of range (``speed``: u above its
+        maximum counts), as an error to raise or log; None if all are valid."""
         w = np.asarray(w, dtype=float)
         ok = np.isfinite(w) & (w >= self._range_lo) & (w <= self._range_hi)
         u = w[0]
-        speed_ok = math.isfinite(u) and u <= RANGES["speed"].high
+        speed_ok = not speed or (math.isfinite(u) and u <= RANGES["speed"].high)
         if ok.all() and speed_ok:
-            return
+            return None
         for k, name in enumerate(self.input_names):
             val = w[k]
             if not math.isfinite(val):
-                raise CosimError(name, f"input {name} is not finite ({val!r}); the step is refused and the state "
-                                       "is unchanged")
+                return CosimError(name, f"input {name} is not finite ({val!r}); the step is refused and the state "
+                                        "is unchanged")
             if k == 0 and not speed_ok:
-                raise CosimError(name, f"input u = {val:.6g} m/s is above {RANGES['speed'].high:g} m/s, the fastest "
-                                       "speed the model is run at; the step is refused and the state is unchanged")
+                return CosimError(name, f"input u = {val:.6g} m/s is above {RANGES['speed'].high:g} m/s, the fastest "
+                                        "speed the model is run at; the step is refused and the state is unchanged")
             if not ok[k]:
-                r = self._ranges[k]
-                raise CosimError(name, f"input {name} = {val:.6g} is outside {r.text()}; the step is refused and "
-                                       "the state is unchanged")
+                return CosimError(name, f"input {name} = {val:.6g} is outside {self._ranges[k].text()}; the step is "
+                                        "refused and the state is unchanged")
+        return None  # pragma: no cover
+
+    def check_inputs(self, w) -> None:
+        """Raise :class:`CosimError` naming the first input that is not finite or out of range."""
+        problem = self.input_problem(w)
+        if problem is not None:
+            raise problem
 
     # ------------------------------------------------------------------ caches
     def _step_matrix(self, u: float, h: float) -> np.ndarray:
@@ -293,8 +300,12 @@ class LCVEngine:
         return self.last_speed_mps
 
     def outputs(self, w) -> np.ndarray:
-        """Every output (interface order), SI, at the current state and inputs ``w``."""
+        """Every output (interface order), SI, at the current state and inputs ``w``.
+
+        The lateral accelerations depend on the inputs directly: while an input is not
+        finite or out of range they are NaN and :attr:`output_error` says which input."""
         w = np.asarray(w, dtype=float)
+        self.output_error = None
         out = self._C @ self.z
         if self._has_y:
             out += self._W @ np.sin(self._H @ self.z)
@@ -302,10 +313,15 @@ class LCVEngine:
         if sel.any() or self._eig_out >= 0:
             u = self.output_speed(w)
             if sel.any():
-                wf = np.where(np.isfinite(w), w, 0.0)
-                maps = self._speed_maps(u)
-                ay = maps["Ca"] @ self.z[:self.n] + maps["DaB"] @ wf
-                out[sel] = ay[self._ay_unit[sel]]
+                problem = self.input_problem(w, speed=False)
+                if problem is None:
+                    maps = self._speed_maps(u)
+                    ay = maps["Ca"] @ self.z[:self.n] + maps["DaB"] @ w
+                    out[sel] = ay[self._ay_unit[sel]]
+                else:
+                    out[sel] = np.nan
+                    self.output_error = (f"the lateral accelerations depend on the inputs and {problem.variable} is "
+                                         f"not valid: {problem}")
             if self._eig_out >= 0:
                 out[self._eig_out] = self.max_real_eig(u)
         return out

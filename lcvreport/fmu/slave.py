@@ -1,0 +1,265 @@
+"""The pythonfmu slave of the FMUs: FMI calls mapped onto the engine (pythonfmu only).
+
+Loaded inside an FMU by the slave module ``fmu_src/LCV.py``.  The variables come from
+the interface table
+(:mod:`lcvreport.fmu.interface`) and every computation from
+:class:`lcvreport.fmu.engine.LCVEngine` (SI, exact zero-order-hold stepping, numpy
+only).  ``resources/lcv_fmu.json`` says which interface: the six presets (SPEC
+section 5, ``build/LCV.fmu``) or one vehicle built in (SPEC section 9,
+``lcv fmu --vehicle ...``).
+
+No exception may leave a callback: pythonfmu 0.7.0 turns one into fmi2Fatal after
+releasing the Python instance, which fmi2FreeInstance then releases again (a
+use-after-free that crashes the host).  Every callback catches, logs with
+fmi2Error and returns something harmless; the FMU's loader (``fmu_src/c/loader.c``)
+turns a call that logged an error into the fmi2Error status the standard asks for.
+"""
+import json
+import math
+import os
+import sys
+
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real, String
+from pythonfmu.enums import Fmi2Status
+
+from lcvreport.fmu.engine import CosimError, LCVEngine, state_from_bytes, state_to_bytes
+from lcvreport.fmu.model_description import model_description
+from lcvreport.fmu.interface import preset_interface, vehicle_interface
+from lcvreport.model.vehicle_file import load_vehicle
+
+
+def _interface(resources: str):
+    """The interface of the FMU whose resources folder is ``resources``."""
+    with open(os.path.join(resources, "lcv_fmu.json"), encoding="utf-8") as f:
+        cfg = json.load(f)
+    if cfg["mode"] == "presets":
+        return preset_interface()
+    return vehicle_interface(load_vehicle(os.path.join(resources, cfg["vehicle_file"])))
+
+
+_CAUSALITY = {"parameter": Fmi2Causality.parameter, "input": Fmi2Causality.input, "output": Fmi2Causality.output}
+_VARIABILITY = {"fixed": Fmi2Variability.fixed, "continuous": Fmi2Variability.continuous}
+
+
+class LCV(Fmi2Slave):
+    """The slave: one vehicle (or the six presets) through the interface table."""
+
+    author = "lcvreport"
+    license = "MIT"
+    version = "0.2.0"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        # pythonfmu 0.7.0 inserts the resources folder into sys.path on every instantiation:
+        # keep one entry
+        if self.resources and sys.path.count(self.resources) > 1:
+            sys.path[:] = [self.resources] + [p for p in sys.path if p != self.resources]
+        self.itf = _interface(self.resources)
+        self.modelName = self.itf.model_name
+        self.description = self.itf.description
+        self.params = {v.name: v.start for v in self.itf.parameters}
+        self.inputs = [float(v.start) for v in self.itf.inputs]
+        self.input_slot = {v.value_reference: k for k, v in enumerate(self.itf.inputs)}
+        self.output_slot = {v.value_reference: k for k, v in enumerate(self.itf.outputs)}
+        self.engine = None
+        self.init_error = None
+        self.initialized = False
+        self.outputs = [0.0] * len(self.itf.outputs)
+        for v in self.itf.variables:  # value reference = registration order = table index
+            kw = dict(causality=_CAUSALITY[v.causality], variability=_VARIABILITY[v.variability],
+                      description=v.description)
+            if v.causality == "output":
+                kw["initial"] = Fmi2Initial.calculated
+            var = (String if v.type == "String" else Real)(v.name, getter=lambda: 0.0, setter=lambda x: None, **kw)
+            self.register_variable(var)
+            assert var.value_reference == v.value_reference
+
+    # ---------------------------------------------------------------- errors
+    def _error(self, text):
+        self.log(text, Fmi2Status.error, "logStatusError")
+
+    # ---------------------------------------------------------------- FMI calls
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        pass
+
+    def enter_initialization_mode(self):
+        pass
+
+    def exit_initialization_mode(self):
+        try:
+            if self.initialized:
+                self._error("fmi2ExitInitializationMode called twice; call fmi2Reset to start again")
+                return
+            self.engine = LCVEngine(self.itf, self.params.get("preset"), self.params["tire_scale"],
+                                    self.params["u_min"])
+            self.init_error = None
+            self.initialized = True
+        except CosimError as exc:
+            self.engine = None
+            self.init_error = str(exc)
+            self._error(f"{exc}; every doStep will be refused")
+        except Exception as exc:  # noqa: BLE001
+            self.engine = None
+            self.init_error = f"initialization failed: {type(exc).__name__}: {exc}"
+            self._error(self.init_error)
+
+    def do_step(self, current_time, step_size):
+        try:
+            if self.engine is None:
+                self._error(self.init_error and f"{self.init_error}; every doStep will be refused"
+                            or "fmi2DoStep called before initialization completed")
+                return False
+            warning = self.engine.step(float(step_size), self.inputs)
+            if warning:
+                self.log(warning, Fmi2Status.warning, "logStatusWarning")
+            return True
+        except CosimError as exc:
+            self._error(str(exc))
+            return False
+        except Exception as exc:  # noqa: BLE001
+            self._error(f"doStep failed: {type(exc).__name__}: {exc}; the state is unchanged")
+            return False
+
+    def terminate(self):
+        pass
+
+    # ---------------------------------------------------------------- values
+    def get_real(self, vrs):
+        out = [0.0] * len(vrs)
+        try:
+            values = None
+            for i, vr in enumerate(vrs):
+                if vr in self.input_slot:
+                    out[i] = float(self.inputs[self.input_slot[vr]])
+                elif vr in self.output_slot:
+                    if self.engine is None:
+                        continue
+                    if values is None:
+                        values = self.engine.outputs(self.inputs)
+                    value = float(values[self.output_slot[vr]])
+                    if math.isfinite(value):
+                        out[i] = value
+                    else:
+                        self._error(self.engine.output_error or f"output {self.itf.variables[vr].name} is not finite")
+                elif 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].type == "Real":
+                    out[i] = float(self.params[self.itf.variables[vr].name])
+                else:
+                    self._error(f"fmi2GetReal: {vr} is not the value reference of a Real variable")
+        except Exception as exc:  # noqa: BLE001
+            self._error(f"fmi2GetReal failed: {type(exc).__name__}: {exc}")
+        return [v if math.isfinite(v) else 0.0 for v in out]
+
+    def set_real(self, vrs, values):
+        try:
+            for vr, value in zip(vrs, values):
+                if vr in self.input_slot:
+                    self.inputs[self.input_slot[vr]] = float(value)
+                elif 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].causality == "parameter" \
+                        and self.itf.variables[vr].type == "Real":
+                    name = self.itf.variables[vr].name
+                    if self.initialized or self.init_error is not None:
+                        self._error(f"{name} is a fixed parameter: it cannot change after initialization")
+                    else:
+                        self.params[name] = float(value)
+                else:
+                    self._error(f"fmi2SetReal: {vr} is not the value reference of an input or a Real parameter")
+        except Exception as exc:  # noqa: BLE001
+            self._error(f"fmi2SetReal failed: {type(exc).__name__}: {exc}")
+
+    def get_string(self, vrs):
+        out = [""] * len(vrs)
+        for i, vr in enumerate(vrs):
+            if 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].type == "String":
+                out[i] = str(self.params[self.itf.variables[vr].name])
+            else:
+                self._error(f"fmi2GetString: {vr} is not the value reference of a String variable")
+        return out
+
+    def set_string(self, vrs, values):
+        try:
+            for vr, value in zip(vrs, values):
+                if 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].type == "String":
+                    name = self.itf.variables[vr].name
+                    if self.initialized or self.init_error is not None:
+                        self._error(f"{name} is a fixed parameter: it cannot change after initialization")
+                    else:
+                        self.params[name] = str(value)
+                else:
+                    self._error(f"fmi2SetString: {vr} is not the value reference of a String variable")
+        except Exception as exc:  # noqa: BLE001
+            self._error(f"fmi2SetString failed: {type(exc).__name__}: {exc}")
+
+    def get_integer(self, vrs):
+        if len(vrs):
+            self._error("fmi2GetInteger: this FMU has no Integer variables")
+        return [0] * len(vrs)
+
+    def set_integer(self, vrs, values):
+        if len(vrs):
+            self._error("fmi2SetInteger: this FMU has no Integer variables")
+
+    def get_boolean(self, vrs):
+        if len(vrs):
+            self._error("fmi2GetBoolean: this FMU has no Boolean variables")
+        return [False] * len(vrs)
+
+    def set_boolean(self, vrs, values):
+        if len(vrs):
+            self._error("fmi2SetBoolean: this FMU has no Boolean variables")
+
+    # ---------------------------------------------------------------- FMU state
+    def _get_fmu_state(self):
+        try:
+            return {"model": self.itf.model_name, "params": dict(self.params), "inputs": list(self.inputs),
+                    "initialized": self.initialized, "init_error": self.init_error,
+                    "engine": None if self.engine is None else self.engine.get_state()}
+        except Exception as exc:  # noqa: BLE001
+            self._error(f"fmi2GetFMUstate failed: {type(exc).__name__}: {exc}")
+            return {"invalid": str(exc)}
+
+    def _set_fmu_state(self, state):
+        try:
+            if not isinstance(state, dict) or "invalid" in state or state.get("model") != self.itf.model_name:
+                reason = state.get("invalid") if isinstance(state, dict) and "invalid" in state else \
+                    "it was not written by this FMU"
+                self._error(f"fmi2SetFMUstate: the FMU state is refused: {reason}; the instance is unchanged")
+                return
+            inputs = [float(x) for x in state["inputs"]]
+            if len(inputs) != len(self.inputs):
+                self._error("fmi2SetFMUstate: the FMU state does not fit this FMU; the instance is unchanged")
+                return
+            params = dict(state["params"])
+            engine = None
+            if state["engine"] is not None:
+                engine = self.engine
+                if engine is None or (engine.preset, engine.tire_scale, engine.u_min) != \
+                        (params.get("preset"), params["tire_scale"], params["u_min"]):
+                    engine = LCVEngine(self.itf, params.get("preset"), params["tire_scale"], params["u_min"])
+                engine.set_state(state["engine"])
+            self.params, self.inputs, self.engine = params, inputs, engine
+            self.initialized, self.init_error = bool(state["initialized"]), state["init_error"]
+        except CosimError as exc:
+            self._error(f"fmi2SetFMUstate: {exc}; the instance is unchanged")
+        except Exception as exc:  # noqa: BLE001
+            self._error(f"fmi2SetFMUstate: the FMU state is refused ({type(exc).__name__}: {exc}); "
+                        "the instance is unchanged")
+
+    @staticmethod
+    def _fmu_state_to_bytes(state):
+        try:
+            return state_to_bytes(state)
+        except Exception as exc:  # noqa: BLE001
+            return state_to_bytes({"invalid": f"{type(exc).__name__}: {exc}"})
+
+    @staticmethod
+    def _fmu_state_from_bytes(data):
+        try:
+            return state_from_bytes(data)
+        except Exception as exc:  # noqa: BLE001
+            return {"invalid": f"the serialized FMU state cannot be read ({type(exc).__name__}: {exc})"}
+
+    # ---------------------------------------------------------------- XML
+    def to_xml(self, model_options=dict()):
+        from xml.etree.ElementTree import fromstring
+        return fromstring(model_description(self.itf, self.itf.model_name, native=False,
+                                            generation_tool="lcvreport.fmu.build (pythonfmu 0.7.0)"))
