@@ -61,7 +61,7 @@ report() {
 }
 
 run_tests() {
-    "$PY" -m pytest -q -n 2 -p no:cacheprovider "$@"
+    "$PY" -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider "$@"
 }
 
 cmd="${1:-all}"

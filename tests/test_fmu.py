@@ -264,3 +264,50 @@ def test_other_masters_give_the_package_values(preset_fmu, master):
     # libcosim passes step sizes from its nanosecond clock (0.01 s +- 1 ulp): the same exact
     # response of slightly different steps, within the conditioning
     assert err <= tolerance(kappa), f"{name}: {err:.2e} (kappa {kappa:.3g})"
+
+
+def test_ecos_command_line_runner_with_an_ssp(native_fmu, tmp_path):
+    """ecos' own executable on a System Structure (SSP) that sets the preset and two loads."""
+    import csv
+    import os
+    import shutil
+
+    import ecospy
+    ecos = Path(ecospy.__file__).parent / "binaries" / "ecos"
+    os.chmod(ecos, 0o755)
+    ssp = tmp_path / "ssp"
+    (ssp / "resources").mkdir(parents=True)
+    shutil.copy(native_fmu, ssp / "resources" / "LCVNative.fmu")
+    (ssp / "SystemStructure.ssd").write_text("""<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
+  xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
+  xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" version="1.0" name="lcv">
+  <ssd:System name="lcv"><ssd:Elements>
+    <ssd:Component name="truck" source="resources/LCVNative.fmu"><ssd:ParameterBindings><ssd:ParameterBinding>
+      <ssd:ParameterValues><ssv:ParameterSet version="1.0" name="init"><ssv:Parameters>
+        <ssv:Parameter name="preset"><ssv:String value="tractor_semitrailer"/></ssv:Parameter>
+        <ssv:Parameter name="P21"><ssv:Real value="2000"/></ssv:Parameter>
+        <ssv:Parameter name="T21"><ssv:Real value="-500"/></ssv:Parameter>
+      </ssv:Parameters></ssv:ParameterSet></ssd:ParameterValues>
+    </ssd:ParameterBinding></ssd:ParameterBindings></ssd:Component>
+  </ssd:Elements></ssd:System>
+</ssd:SystemStructureDescription>
+""")
+    p = subprocess.run([str(ecos), "simulate", "--path", str(ssp), "--stopTime", "2", "--stepSize", "0.01",
+                        "--noParallel", "--parameterSet", "init"], cwd=tmp_path, capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 0, p.stdout + p.stderr
+    rows = list(csv.reader(open(tmp_path / "ssp.csv")))
+    header = [h.strip() for h in rows[0]]
+    data = {h: np.array([float(r[i]) for r in rows[1:]]) for i, h in enumerate(header)
+            if h == "time" or h.endswith("[REAL]")}
+    steps = [(0.01, {"P21": 2000.0, "T21": -500.0})] + [(0.01, {})] * 199
+    ref = reference_outputs(ITF, steps, "tractor_semitrailer")
+    k = np.array([round(t / 0.01) for t in data["time"]])
+    keep = k >= 1
+    names = [v.name for v in ITF.outputs]
+    for name in ("y2", "thetaA", "Y_rear"):
+        # the CSV prints 6 decimals
+        np.testing.assert_allclose(data[f"truck::{name}[REAL]"][keep], ref[k[keep] - 1, names.index(name)],
+                                   rtol=0, atol=6e-7)
+    assert abs(ref[-1, names.index("y2")]) > 1e-3          # a real response, not zeros

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import TOOLS
+from conftest import EXAMPLE_NAMES, TOOLS
 from fmu_support import host_env, host_statuses, host_values, interface_of, run_host, unzip
 from helpers import group_error, reference_outputs, schedule_condition, tolerance
 
@@ -21,10 +21,15 @@ T_END = 3.0
 H = 0.01
 
 
-@pytest.fixture(scope="module", params=["LCV", "LCVNative", "western_python", "western_native"])
-def any_fmu(request, lcv_fmu, native_fmu, western_fmus):
-    return {"LCV": lcv_fmu, "LCVNative": native_fmu, "western_python": western_fmus["python"],
-            "western_native": western_fmus["native"]}[request.param]
+FMUS = ["LCV", "LCVNative"] + [f"{name}:{kind}" for name in EXAMPLE_NAMES for kind in ("python", "native")]
+
+
+@pytest.fixture(scope="module", params=FMUS)
+def any_fmu(request, lcv_fmu, native_fmu, all_example_fmus):
+    if ":" in request.param:
+        name, kind = request.param.split(":")
+        return all_example_fmus[name][kind]
+    return {"LCV": lcv_fmu, "LCVNative": native_fmu}[request.param]
 
 
 def _inputs(itf) -> dict:
@@ -163,3 +168,39 @@ def test_lcv_fmu_in_a_c_host_under_valgrind(c_host, lcv_fmu, tmp_path):
     assert "ERROR SUMMARY" in p.stderr
     for report in valgrind_reports(p.stderr):
         assert "dl-load.c" in report and "LCV.so" not in report and "pythonfmu-export" not in report, report
+
+
+# ---------------------------------------------------------------------------- the C FMU in a plain C host
+def test_c_fmu_in_a_c_host_gives_exactly_what_fmpy_gives(c_host, native_fmu, tmp_path):
+    """Same binary, two hosts (one without Python in the process): identical numbers."""
+    from fmu_support import Slave, run_schedule
+    from helpers import schedule
+    unz = unzip(native_fmu, tmp_path / "native")
+    vr = unz[2]
+    steps = schedule(np.random.default_rng(21), 80, [0.002, 0.02, 0.1], ("11", "21", "61"), clamp=True)
+    itf = interface_of(native_fmu)
+    outs = [v.name for v in itf.outputs]
+    lines, t = ["S {} legal_max".format(vr["preset"]), "i"], 0.0
+    for h, inputs in steps:
+        lines += [f"s {vr[k]} {v!r}" for k, v in inputs.items()]
+        lines += [f"d {t!r} {h!r}", "g " + " ".join(str(vr[o]) for o in outs)]
+        t += h
+    p = run_host(c_host, unz, "LCVNative", "\n".join(lines) + "\n")
+    assert p.returncode == 0 and p.stdout.rstrip().endswith("done"), p.stderr
+    assert set(host_statuses(p.stdout)) == {0}
+    s = Slave(native_fmu, preset="legal_max").init()
+    ref = run_schedule(s, steps)
+    s.free()
+    np.testing.assert_array_equal(host_values(p.stdout), ref)
+
+
+@pytest.mark.slow
+def test_valgrind_memcheck_one_million_steps_of_the_c_fmu(c_host, native_fmu, tmp_path):
+    d, guid, vr = unzip(native_fmu, tmp_path / "native")
+    assert shutil.which("valgrind"), "valgrind is not installed (./build.sh setup installs it)"
+    p = subprocess.run(["valgrind", "--tool=memcheck", "--leak-check=full", "--show-leak-kinds=all",
+                        "--errors-for-leak-kinds=all", "--error-exitcode=99", str(c_host), str(d), "LCVNative",
+                        guid, "bench", "1000000", "0.001", str(vr["P61"]), str(vr["y6"])],
+                       capture_output=True, text=True, timeout=3000)
+    assert p.returncode == 0, p.stderr[-3000:]
+    assert "ERROR SUMMARY: 0 errors" in p.stderr and "All heap blocks were freed" in p.stderr

@@ -1,7 +1,18 @@
-"""The report: every notebook runs (fast mode), every figure and table number is in the
-HTML, the CSVs are deterministic, a failing notebook fails the build loudly."""
+"""The two reports.
+
+The thesis report (``python -m lcvreport.report.build``, fast mode): every notebook runs,
+every figure and table number is in the HTML, CSVs are deterministic, a failing notebook
+fails the build loudly; every notebook runs for every preset it accepts and refuses the
+others before any cell runs; captions follow the parameters; ``data_dir`` is absolute;
+the PDF has no line or table running into the margin.
+
+The assessment report (``lcv report``) of an example vehicle file and of a preset: both
+documents, a CSV per table and figure, captions naming the vehicle and speed, and the
+measures table equal to ``lcv measures``.
+"""
 from __future__ import annotations
 
+import csv
 import filecmp
 import json
 import re
@@ -9,9 +20,15 @@ import subprocess
 import sys
 from pathlib import Path
 
+import nbformat
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from lcvreport.fmu.interface import vehicle_interface
+from lcvreport.model.presets import PRESETS
+from lcvreport.model.vehicle_file import load_vehicle
+from lcvreport.report.build import NOTEBOOKS, SPECS, ReportError, execute, overfull_boxes
+
+from conftest import EXAMPLES, ROOT
 
 FIGURES = (["1-2", "2-1", "2-2", "2-5", "2-6", "2-8", "2-10"] + [f"3-{i}" for i in range(1, 14)]
            + [f"4-{i}" for i in range(1, 17)] + [f"5-{i}" for i in range(1, 22)] + ["D.1", "D.2", "D.3"])
@@ -20,11 +37,17 @@ TABLES = (["3-1", "3-2", "3-3"] + [f"5-{i}" for i in range(1, 5)] + [f"B.{i}" fo
           + ["eq. 3.17", "eq. 3.18", "eq. 3.20", "eq. 3.34", "eq. 4.14", "eq. 4.17"]
           + ["E.M1", "E.M2", "E.S1", "E.S2", "E.F"])
 NOT_REPRODUCED = ["1-1", "1-3", "1-4", "1-5", "2-3", "2-4", "2-7", "2-9", "2-11", "4-17"]
+# Tests that share a built report run on one xdist worker (./build.sh test uses
+# --dist loadgroup), so each report is built once.
+
+#: how far a line may run into the margin [pt] (TeX's own tolerance is 0.1 pt; a table
+#: that does not fit runs tens of points over)
+OVERFULL_PT = 1.0
 
 
 def _build(build_dir: Path, *extra: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "lcvreport.report", "--build-dir", str(build_dir), "--fast", *extra],
-                          capture_output=True, text=True, cwd=ROOT, timeout=900)
+    return subprocess.run([sys.executable, "-m", "lcvreport.report.build", "--build-dir", str(build_dir), "--fast",
+                           *extra], capture_output=True, text=True, cwd=ROOT, timeout=900)
 
 
 @pytest.fixture(scope="module")
@@ -35,9 +58,11 @@ def built(tmp_path_factory):
     return d
 
 
+# ---------------------------------------------------------------------------- the thesis report
+@pytest.mark.xdist_group("thesis_report")
 def test_every_notebook_ran_and_both_documents_exist(built):
     executed = sorted(x.stem for x in (built / "notebooks").glob("*.ipynb"))
-    assert executed == sorted(x.stem for x in (ROOT / "notebooks").glob("*.ipynb"))
+    assert executed == sorted(s.stem for s in NOTEBOOKS)
     html = built / "report" / "index.html"
     pdf = built / "report" / "report.pdf"
     assert html.stat().st_size > 100_000
@@ -45,25 +70,39 @@ def test_every_notebook_ran_and_both_documents_exist(built):
     assert (built / "report" / "mathjax" / "MathJax.js").exists()
 
 
+@pytest.mark.xdist_group("thesis_report")
 def test_html_holds_every_figure_and_table_number(built):
     text = (built / "report" / "index.html").read_text(encoding="utf-8")
     missing = [f for f in FIGURES if f"Figure {f}.</strong>" not in text]
     assert not missing, f"figures missing: {missing}"
-    missing = [t for t in TABLES if f"Table {t}.</strong>" not in text]
+    missing = [t for t in TABLES if f"Table {t}.</b>" not in text]
     assert not missing, f"tables missing: {missing}"
     for f in NOT_REPRODUCED:
-        assert re.search(rf"<td>{re.escape(f)}</td>", text), f"figure {f} not listed as not reproduced"
-    for anchor in ("ch1", "ch3", "ch4", "ch5", "app", "audit"):
-        assert f'href="#{anchor}"' in text and f'id="{anchor}"' in text
+        assert re.search(rf"<td[^>]*>{re.escape(f)}</td>", text), f"figure {f} not listed as not reproduced"
+    for s in NOTEBOOKS:
+        assert f'href="#{s.anchor}"' in text and f'id="{s.anchor}"' in text
 
 
+@pytest.mark.xdist_group("thesis_report")
 def test_html_reads_offline(built):
     text = (built / "report" / "index.html").read_text(encoding="utf-8")
     assert not re.search(r'(src|href)="https?://', text), "the HTML loads something from the network"
     assert 'src="mathjax/MathJax.js' in text
-    assert "data:image/png;base64" in text or "<svg" in text
+    assert "data:image/svg+xml" in text                       # figures embedded
 
 
+@pytest.mark.xdist_group("thesis_report")
+def test_pdf_has_nothing_in_the_margin(built):
+    """No table or line wider than the text (LaTeX's own measure, from the log of the run)."""
+    boxes = overfull_boxes((built / "report" / "latex.log").read_text(errors="replace"))
+    assert not [b for b in boxes if b[0] > OVERFULL_PT], boxes[:5]
+    text = subprocess.run(["pdftotext", "-layout", str(built / "report" / "report.pdf"), "-"], capture_output=True,
+                          text=True, check=True).stdout
+    # the published-vs-recomputed tables read as tables: their headers are whole words
+    assert "published" in text and "recomputed" in text and "the-\nsis" not in text
+
+
+@pytest.mark.xdist_group("thesis_report")
 def test_every_table_has_a_csv_with_units_in_the_header(built):
     data = built / "report" / "data"
     for t in TABLES[:-5]:
@@ -73,6 +112,7 @@ def test_every_table_has_a_csv_with_units_in_the_header(built):
     assert "corrected_steady_in" in header and "velocity_mph" in header
 
 
+@pytest.mark.xdist_group("thesis_report")
 def test_audit_lists_every_published_number(built):
     rows = (built / "report" / "data" / "table_A-1.csv").read_text()
     for where in ("eq. 3.17", "eq. 3.18", "eq. 3.20", "eq. 3.22-3.25", "eq. 3.34", "eq. 3.35-3.38", "eq. 4.14",
@@ -82,6 +122,7 @@ def test_audit_lists_every_published_number(built):
         assert verdict in rows
 
 
+@pytest.mark.xdist_group("thesis_report")
 def test_two_builds_give_identical_csvs(built, tmp_path):
     p = _build(tmp_path, "--no-pdf")
     assert p.returncode == 0, p.stderr[-4000:]
@@ -102,16 +143,200 @@ def test_failing_notebook_fails_the_build_and_leaves_no_stale_report(tmp_path):
     stale.mkdir(parents=True)
     (stale / "index.html").write_text("old report")
     (stale / "report.pdf").write_text("old report")
-    p = subprocess.run([sys.executable, "-m", "lcvreport.report", "--build-dir", str(tmp_path / "build"), "--fast",
-                        "--notebooks", str(nbdir)], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    p = subprocess.run([sys.executable, "-m", "lcvreport.report.build", "--build-dir", str(tmp_path / "build"),
+                        "--fast", "--notebooks", str(nbdir)], capture_output=True, text=True, cwd=ROOT, timeout=600)
     assert p.returncode != 0
     assert "broken.ipynb" in p.stderr and "cell 3" in p.stderr and "deliberately broken" in p.stderr
     assert not (stale / "index.html").exists() and not (stale / "report.pdf").exists()
 
 
-def test_bad_notebook_parameter_is_named(tmp_path):
+# ---------------------------------------------------------------------------- parameters
+def _accepted(stem: str) -> tuple[str, ...]:
+    """The presets notebook ``stem`` serves, asked of its parameter check."""
+    from lcvreport.report.build import check_notebook_parameters
+    ok = []
+    for p in PRESETS:
+        try:
+            check_notebook_parameters(stem, {"preset": p})
+            ok.append(p)
+        except ReportError:
+            pass
+    return tuple(ok)
+
+
+WITH_PRESET = [s.stem for s in NOTEBOOKS if "preset" in s.parameters]
+#: every (notebook, preset) it accepts, but the default preset (the full build runs that)
+PRESET_RUNS = [(stem, p) for stem in WITH_PRESET for p in _accepted(stem) if p != "aucnat"]
+REFUSED = [(stem, p) for stem in WITH_PRESET for p in PRESETS if p not in _accepted(stem)]
+
+
+def test_the_presets_each_notebook_serves():
+    assert set(WITH_PRESET) == {"ch1_2_concepts", "ch4_triple", "appendices"}
+    assert _accepted("appendices") == PRESETS
+    assert _accepted("ch4_triple") == _accepted("ch1_2_concepts") == tuple(p for p in PRESETS
+                                                                          if p != "tractor_semitrailer")
+
+
+@pytest.mark.parametrize("stem, preset", PRESET_RUNS)
+def test_every_notebook_runs_for_every_preset_it_accepts(stem, preset, tmp_path):
+    out = execute(stem, tmp_path, {"fast": True, "data_dir": str(tmp_path / "data"), "preset": preset})
+    nb = nbformat.read(out, as_version=4)
+    errors = [o for c in nb.cells for o in c.get("outputs", []) if o.get("output_type") == "error"]
+    assert not errors
+    assert any((tmp_path / "data").iterdir())
+
+
+@pytest.mark.parametrize("stem, preset", REFUSED)
+def test_a_preset_a_notebook_cannot_serve_is_refused_before_any_cell_runs(stem, preset, tmp_path):
+    with pytest.raises(ReportError, match=rf"parameter preset: this notebook serves .*needs a triple.*{preset}"):
+        execute(stem, tmp_path, {"fast": True, "data_dir": None, "preset": preset})
+    assert not (tmp_path / f"{stem}.ipynb").exists()          # papermill never started
+
+
+def test_papermill_run_directly_stops_at_the_check_with_the_parameter_named(tmp_path):
     import papermill as pm
     with pytest.raises(pm.PapermillExecutionError, match="parameter preset"):
         pm.execute_notebook(str(ROOT / "notebooks" / "ch4_triple.ipynb"), str(tmp_path / "out.ipynb"),
                             parameters={"preset": "aucant", "fast": True, "data_dir": str(tmp_path)},
-                            kernel_name="python3", cwd=str(ROOT / "notebooks"), progress_bar=False)
+                            kernel_name="python3", cwd=str(tmp_path), progress_bar=False)
+    nb = nbformat.read(tmp_path / "out.ipynb", as_version=4)
+    shown = [o for c in nb.cells for o in c.get("outputs", []) if o.get("output_type") == "display_data"]
+    assert not shown                                           # nothing computed before the refusal
+
+
+def _markdown_outputs(path: Path) -> str:
+    nb = nbformat.read(path, as_version=4)
+    return "\n".join(o["data"]["text/markdown"] for c in nb.cells for o in c.get("outputs", [])
+                     if "text/markdown" in o.get("data", {}))
+
+
+def test_captions_follow_the_parameters(tmp_path):
+    """Run at 55 mph with legal_max, every figure of the run says so; only the published
+    case (eq. 4.14, 4.17, the AU-NCAT test of Figure 4-16) keeps its own vehicle and speed."""
+    out = execute("ch4_triple", tmp_path, {"fast": True, "data_dir": None, "preset": "legal_max", "speed_mph": 55.0})
+    captions = dict(re.findall(r"\*\*Figure (4-\d+)\.\*\*([^\n]*)", _markdown_outputs(out)))
+    assert sorted(captions, key=lambda n: int(n[2:])) == [f"4-{i}" for i in range(1, 17)]
+    for number in [f"4-{i}" for i in range(1, 16)]:
+        caption = captions[number].replace("published AU-NCAT values at 50 mph", "")
+        assert "legal_max" in caption and "aucnat" not in caption and "50 mph" not in caption, (number, caption)
+    for number in [f"4-{i}" for i in (2, 3, 4, 5, 6, 7, 8, 12, 13, 14, 15)]:
+        assert "55 mph" in captions[number], (number, captions[number])
+    assert "Table B.2" in captions["4-1"]                     # legal_max's dimensions table
+
+
+def test_relative_data_dir_is_resolved_against_the_run_folder(tmp_path):
+    """papermill run from another folder writes the CSVs where data_dir says, resolved
+    to an absolute path in the notebook's working folder -- not next to the notebook."""
+    import papermill as pm
+    work = tmp_path / "elsewhere"
+    work.mkdir()
+    pm.execute_notebook(str(ROOT / "notebooks" / "appendices.ipynb"), str(work / "out.ipynb"),
+                        parameters={"fast": True, "data_dir": "csv"}, kernel_name="python3", cwd=str(work),
+                        progress_bar=False)
+    assert sorted(p.name for p in (work / "csv").iterdir())[:1] == ["figure_D_1.csv"]
+    assert not (ROOT / "notebooks" / "csv").exists()
+
+
+# ---------------------------------------------------------------------------- the assessment report
+def _lcv(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "lcvreport.cli", *args], capture_output=True, text=True,
+                          timeout=600, cwd=cwd)
+
+
+ASSESSMENTS = {"western_double": ["--vehicle", str(EXAMPLES / "western_double.toml")],
+               "aucnat": ["--preset", "aucnat", "--load", "trailer2,trailer3"]}
+
+
+@pytest.fixture(scope="module", params=sorted(ASSESSMENTS))
+def assessment(request, tmp_path_factory):
+    out = tmp_path_factory.mktemp(f"assess_{request.param}")
+    p = _lcv("report", *ASSESSMENTS[request.param], "--speed-kph", "88", "--out", str(out), cwd=out.parent)
+    assert p.returncode == 0, (p.stdout + p.stderr)[-4000:]
+    return request.param, out, p
+
+
+@pytest.mark.xdist_group("assessment")
+def test_assessment_writes_both_documents_with_a_progress_line(assessment):
+    name, out, p = assessment
+    assert (out / "index.html").stat().st_size > 50_000
+    assert (out / "report.pdf").read_bytes()[:5] == b"%PDF-"
+    text = p.stdout + p.stderr
+    assert re.search(r"notebook assessment: \d+\.\d s", text)
+    assert "Traceback" not in text and "WARNING" not in text
+
+
+@pytest.mark.xdist_group("assessment")
+def test_assessment_has_a_csv_for_every_table_and_figure(assessment):
+    name, out, _p = assessment
+    html = (out / "index.html").read_text(encoding="utf-8")
+    figures = sorted(set(re.findall(r"Figure (\d+)\.</strong>", html)), key=int)
+    tables = sorted(set(re.findall(r"Table (\d+)\.</b>", html)), key=int)
+    assert len(figures) >= 9 and len(tables) >= 6
+    for f in figures:
+        assert (out / "data" / f"figure_{f}.csv").stat().st_size > 0, f
+    for t in tables:
+        assert (out / "data" / f"table_{t}.csv").stat().st_size > 0, t
+
+
+@pytest.mark.xdist_group("assessment")
+def test_assessment_captions_name_the_vehicle_and_the_speed(assessment):
+    name, out, _p = assessment
+    text = _markdown_outputs(out / "notebooks" / "assessment.ipynb")
+    captions = re.findall(r"\*\*Figure (\d+)\.\*\*([^\n]*)", text)
+    assert captions and all(name in c for _n, c in captions)
+    assert sum("88 km/h" in c for _n, c in captions) >= len(captions) - 1   # Figure 1 is the drawing
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert f"Yaw-plane assessment of {name} at 88 km/h" in html
+
+
+@pytest.mark.xdist_group("assessment")
+def test_assessment_measures_table_equals_lcv_measures(assessment):
+    name, out, _p = assessment
+    p = _lcv("measures", *ASSESSMENTS[name], "--speed-kph", "88", "--json")
+    assert p.returncode == 0, p.stderr
+    doc = json.loads(p.stdout)
+    with open(out / "data" / "table_4.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    seen = set()
+    for row in rows:
+        key = row["json_key"]
+        m = re.fullmatch(r"(\w+)\[(\d+)\]", key)
+        value = doc[m.group(1)][int(m.group(2))] if m else \
+            doc["trim"][key.split(".")[1]] if key.startswith("trim.") else doc[key]
+        if value is None:
+            assert row["value"] == "none", key
+        else:
+            assert float(row["value"]) == value, key          # the same number, to the last bit
+        seen.add(key.split("[")[0].split(".")[0])
+    assert seen == set(doc)
+
+
+@pytest.mark.xdist_group("assessment")
+def test_assessment_interface_table_is_the_fmu_interface(assessment):
+    name, out, _p = assessment
+    vehicle = load_vehicle(out / "vehicle.toml")
+    with open(out / "data" / "table_6.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    itf = vehicle_interface(vehicle)
+    assert [(r["name"], int(r["value_reference"]), r["causality"]) for r in rows] == \
+        [(v.name, v.value_reference, v.causality) for v in itf.variables]
+
+
+@pytest.mark.xdist_group("assessment")
+def test_assessment_pdf_has_nothing_in_the_margin(assessment):
+    _name, out, _p = assessment
+    boxes = overfull_boxes((out / "latex.log").read_text(errors="replace"))
+    assert not [b for b in boxes if b[0] > OVERFULL_PT], boxes[:5]
+
+
+def test_bad_report_arguments_are_one_line_and_exit_2(tmp_path):
+    for args, fragment in ((["--preset", "aucant"], "preset"), (["--speed-kph", "900"], "speed"),
+                           (["--load", "trailer9"], "load")):
+        base = [] if "--preset" in args else ["--preset", "aucnat"]
+        p = _lcv("report", *base, *args, "--out", str(tmp_path / "r"))
+        assert p.returncode == 2 and fragment in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
+        assert not (tmp_path / "r" / "index.html").exists()
+
+
+def test_every_notebook_has_its_spec():
+    assert sorted(SPECS) == sorted(p.stem for p in (ROOT / "notebooks").glob("*.ipynb"))

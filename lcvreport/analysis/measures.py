@@ -379,6 +379,7 @@ class MeasureSet:
     ay_gain_per_unit: list[float]
     trim: Trim | None = None
     load_units: tuple[str, ...] = ()
+    f_hz: float = RA_FREQUENCY_HZ
 
     def to_dict(self) -> dict:
         """The SPEC section 8 JSON document."""
@@ -391,29 +392,31 @@ class MeasureSet:
         return doc
 
     def rows(self) -> list[dict]:
-        """The measures as table rows (name, value, unit, definition)."""
+        """The measures as table rows: name, value, unit, definition, and the key of the
+        same number in :meth:`to_dict` (``ay_gain_per_unit[0]`` for list items)."""
         def num(v):
             return "none" if v is None else v
+        f = f"{self.f_hz:g} Hz"
         rows = [{"measure": "speed", "value": self.speed_mps, "unit": "m/s",
-                 "note": f"{mps_to_kph(self.speed_mps):.1f} km/h"},
+                 "note": f"{mps_to_kph(self.speed_mps):.1f} km/h", "json_key": "speed_mps"},
                 {"measure": "least damping ratio", "value": num(self.least_damping_ratio), "unit": "-",
-                 "note": "min -Re/|lambda| over oscillatory modes"},
+                 "note": "min −Re λ/|λ| over oscillatory modes", "json_key": "least_damping_ratio"},
                 {"measure": "least damped frequency", "value": num(self.least_damped_frequency_hz), "unit": "Hz",
-                 "note": "Im(lambda)/2 pi of that mode"},
+                 "note": "Im λ/2π of that mode", "json_key": "least_damped_frequency_hz"},
                 {"measure": "critical speed", "value": num(self.critical_speed_kph), "unit": "km/h",
-                 "note": "lowest unstable speed up to 200 km/h (none: stable)"},
-                {"measure": "rearward amplification, 0.4 Hz", "value": self.ra_frequency, "unit": "-",
-                 "note": "|G_N| / |G_1|, frequency domain"},
+                 "note": "lowest unstable speed up to 200 km/h (none: stable)", "json_key": "critical_speed_kph"},
+                {"measure": f"rearward amplification, {f}", "value": self.ra_frequency, "unit": "-",
+                 "note": "|G_N| / |G_1|, frequency domain", "json_key": "ra_frequency"},
                 {"measure": "rearward amplification, single sine", "value": self.ra_single_sine, "unit": "-",
-                 "note": "max|a_N| / max|a_1|, 0.4 Hz single sine"}]
-        for name, g in zip(self.vehicle.unit_names, self.ay_gain_per_unit):
-            rows.append({"measure": f"lateral acceleration gain, {name}", "value": g, "unit": "m/s^2/rad",
-                         "note": "|G_i(j 2 pi 0.4 Hz)|"})
+                 "note": f"max|a_N| / max|a_1|, {f} single sine", "json_key": "ra_single_sine"}]
+        for k, (name, g) in enumerate(zip(self.vehicle.unit_names, self.ay_gain_per_unit)):
+            rows.append({"measure": f"lateral acceleration gain, {name}", "value": g, "unit": "m/s²/rad",
+                         "note": f"|G_{k + 1}(j2π·{f})|", "json_key": f"ay_gain_per_unit[{k}]"})
         if self.trim is not None:
             rows.append({"measure": "trim steer angle", "value": self.trim.delta_rad, "unit": "rad",
-                         "note": f"1 % rule on {', '.join(self.load_units)}"})
+                         "note": f"1 % rule on {', '.join(self.load_units)}", "json_key": "trim.delta_rad"})
             rows.append({"measure": "trimmed offtracking", "value": self.trim.offtracking_m, "unit": "m",
-                         "note": "rearmost axle path - steered axle path, +y"})
+                         "note": "rearmost axle path − steered axle path, +y", "json_key": "trim.offtracking_m"})
         return rows
 
 
@@ -442,4 +445,4 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
         tr = trim(vehicle, speed_mps, F, tire_scale)
     return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
                       critical_speed(vehicle, tire_scale), float(gains[-1] / gains[0]), ss.rearward_amplification,
-                      [float(g) for g in gains], tr, units)
+                      [float(g) for g in gains], tr, units, float(f_hz))

@@ -132,7 +132,7 @@ class Assessment:
         f = self.frequencies_hz
         G = np.abs(measures.steer_to_acceleration(self.vehicle, self.speed_mps, f))
         curves = [(f"|G_{i + 1}| {name}", G[:, i]) for i, name in enumerate(self.vehicle.unit_names)]
-        return plotting.fig_frequency(f, curves, "lateral acceleration per steer angle [m/s^2/rad]",
+        return plotting.fig_frequency(f, curves, "lateral acceleration per steer angle [m/s²/rad]",
                                       f"Steer-to-lateral-acceleration gains of {self.at}", measures.RA_FREQUENCY_HZ,
                                       logy=True)
 
@@ -161,7 +161,7 @@ class Assessment:
         rows = self.sensitivity
         return plotting.fig_bars([f"{s.axle} ({s.unit})" for s in rows],
                                  [("per kN of P", np.array([1e3 * s.offtracking_per_P_m_per_kN for s in rows])),
-                                  ("per kN*m of T", np.array([1e3 * s.offtracking_per_T_m_per_kNm for s in rows]))],
+                                  ("per kN·m of T", np.array([1e3 * s.offtracking_per_T_m_per_kNm for s in rows]))],
                                  "trimmed offtracking [mm]", f"Conicity sensitivity of {self.at}, ranked")
 
     # ------------------------------------------------------------------ FMU

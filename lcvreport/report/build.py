@@ -49,6 +49,10 @@ THESIS_TITLE = "Effect of conicity and ply steer on LCV yaw plane motion: the di
 TRIPLES = PRESETS[:5]
 #: the assessment report's default speed [km/h]
 DEFAULT_SPEED_KPH = 88.0
+#: tag of the merged report's cells that only the HTML shows (title, contents)
+HTML_ONLY = "lcv-html-only"
+#: the kernel logs errors only (its TCP-on-localhost warning is not the reader's concern)
+KERNEL_ARGS = ["--IPKernelApp.log_level=CRITICAL"]
 
 
 class ReportError(RuntimeError):
@@ -205,7 +209,7 @@ def execute(stem: str, out_dir: Path, parameters: dict, source_dir: Path | None 
     dst = out_dir / f"{stem}.ipynb"
     try:
         pm.execute_notebook(str(src), str(dst), parameters=parameters, kernel_name="python3",
-                            cwd=str(out_dir), progress_bar=False, log_output=False)
+                            cwd=str(out_dir), progress_bar=False, log_output=False, extra_arguments=KERNEL_ARGS)
     except pm.PapermillExecutionError as exc:
         where = _failed_cell(src, dst, exc.cell_index)
         raise ReportError(f"notebook {src.name} failed in {where}: {exc.ename}: {exc.evalue} "
@@ -234,10 +238,11 @@ def merge(executed: list[tuple[str, str, str, Path]], title: str, intro: str):
     nb = nbformat.v4.new_notebook()
     nb.metadata = {"title": title, "kernelspec": {"name": "python3", "display_name": "Python 3", "language": "python"},
                    "language_info": {"name": "python"}}
-    toc = ["# " + title, "", intro, ""]
+    html_only = {"tags": [HTML_ONLY]}    # the PDF has its own title page and table of contents
+    cells = [nbformat.v4.new_markdown_cell("# " + title, metadata=html_only), nbformat.v4.new_markdown_cell(intro)]
     if len(executed) > 1:
-        toc += ["## Contents", ""] + [f"{i + 1}. [{t}](#{a})" for i, (_s, a, t, _p) in enumerate(executed)]
-    cells = [nbformat.v4.new_markdown_cell("\n".join(toc))]
+        toc = ["## Contents", ""] + [f"{i + 1}. [{t}](#{a})" for i, (_s, a, t, _p) in enumerate(executed)]
+        cells.append(nbformat.v4.new_markdown_cell("\n".join(toc), metadata=html_only))
     for stem, anchor, part_title, path in executed:
         src = nbformat.read(path, as_version=4)
         if len(executed) > 1:
@@ -279,10 +284,21 @@ def export_html(nb, out_dir: Path) -> Path:
 
 
 def export_pdf(nb, out_dir: Path, author: str) -> Path:
-    """PDF through nbconvert's LaTeX route (xelatex) with the lcvlatex template."""
+    """PDF through nbconvert's LaTeX route (xelatex) with the lcvlatex template; the LaTeX
+    log of the last run is kept as ``latex.log`` beside it (see :func:`overfull_boxes`)."""
     from nbconvert import PDFExporter
-    exporter = PDFExporter(template_name="lcvlatex", extra_template_basedirs=[str(TEMPLATES)], exclude_input=True,
-                           exclude_input_prompt=True, exclude_output_prompt=True)
+
+    class _Exporter(PDFExporter):
+        def run_latex(self, filename, raise_on_failure=None):
+            kwargs = {} if raise_on_failure is None else {"raise_on_failure": raise_on_failure}
+            ok = super().run_latex(filename, **kwargs)
+            log = Path(filename).with_suffix(".log")
+            if log.exists():
+                shutil.copyfile(log, out_dir / "latex.log")
+            return ok
+
+    exporter = _Exporter(template_name="lcvlatex", extra_template_basedirs=[str(TEMPLATES)], exclude_input=True,
+                         exclude_input_prompt=True, exclude_output_prompt=True)
     exporter.latex_command = ["xelatex", "-interaction=batchmode", "-halt-on-error", "{filename}"]
     try:
         pdf, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": "report"}, "lcv_author": author})
@@ -293,9 +309,23 @@ def export_pdf(nb, out_dir: Path, author: str) -> Path:
     return path
 
 
+def overfull_boxes(log_text: str) -> list[tuple[float, str]]:
+    """The overfull horizontal boxes of a LaTeX log: (how much too wide [pt], the
+    log's line), widest first -- a table or line that runs into the margin."""
+    import re
+    out = []
+    lines = log_text.splitlines()
+    for i, line in enumerate(lines):
+        m = re.match(r"Overfull \\hbox \((\d+(?:\.\d+)?)pt too wide\)(.*)", line)
+        if m:
+            context = (m.group(2) + " " + (lines[i + 1] if i + 1 < len(lines) else "")).strip()
+            out.append((float(m.group(1)), context))
+    return sorted(out, key=lambda x: -x[0])
+
+
 def _prepare(out_dir: Path) -> tuple[Path, Path]:
     out_dir.mkdir(parents=True, exist_ok=True)
-    for stale in (out_dir / "index.html", out_dir / "report.pdf"):
+    for stale in (out_dir / "index.html", out_dir / "report.pdf", out_dir / "latex.log"):
         stale.unlink(missing_ok=True)
     data_dir = out_dir / "data"
     if data_dir.exists():
@@ -364,7 +394,7 @@ def _execute_unchecked(stem, nb_dir, params, src):
     dst = nb_dir / f"{stem}.ipynb"
     try:
         pm.execute_notebook(str(src / f"{stem}.ipynb"), str(dst), parameters=params, kernel_name="python3",
-                            cwd=str(nb_dir), progress_bar=False, log_output=False)
+                            cwd=str(nb_dir), progress_bar=False, log_output=False, extra_arguments=KERNEL_ARGS)
     except pm.PapermillExecutionError as exc:
         where = _failed_cell(src / f"{stem}.ipynb", dst, exc.cell_index)
         raise ReportError(f"notebook {stem}.ipynb failed in {where}: {exc.ename}: {exc.evalue} "

@@ -12,6 +12,7 @@ they are printed at (:data:`PAGE_WIDTH_IN`).
 from __future__ import annotations
 
 import numpy as np
+from matplotlib import patheffects
 from matplotlib.figure import Figure
 from matplotlib.patches import FancyArrowPatch, Polygon
 
@@ -134,8 +135,9 @@ def draw_unit(ax, vehicle: Vehicle, k: int, cg: np.ndarray, psi: float, alpha: f
             ax.annotate(joint_letter(k - 1), j, xytext=(0, -12), textcoords="offset points", ha="center",
                         fontsize=SMALL_PT, alpha=alpha)
     if labels:
-        ax.annotate(f"{k + 1}", f * cg, ha="center", va="center", fontsize=8, fontweight="bold", alpha=alpha,
-                    color="white" if kind != "trailer" else "black")
+        ax.annotate(f"{k + 1}", f * cg, xytext=(0, 6), textcoords="offset points", ha="center", va="center",
+                    fontsize=8, fontweight="bold", alpha=alpha, color="black",
+                    path_effects=[patheffects.withStroke(linewidth=2.0, foreground="white")])
 
 
 def draw_vehicle(ax, vehicle: Vehicle, theta: np.ndarray | None = None, alpha: float = 1.0, labels: bool = True,
@@ -179,7 +181,7 @@ def fig_vehicle(vehicle: Vehicle, title: str) -> Figure:
     fig, ax = new_figure(PAGE_WIDTH_IN, 2.4)
     draw_vehicle(ax, vehicle)
     for k, (cg, _psi) in enumerate(poses):
-        ax.plot(cg[0], cg[1], "+", color="red", ms=6, zorder=6)
+        ax.plot(cg[0], cg[1], "+", color="red", ms=5, mew=0.8, zorder=6)
     ax.set_title(f"{title} (to scale; + CG, o coupling; overall about {length + FRONT_OVERHANG_M:.1f} m)",
                  fontsize=8)
     _top_view_axes(ax, "m", ylim_m=2.6)
@@ -205,8 +207,8 @@ def fig_mode_shape(vehicle: Vehicle, modes: Modes, index: int, title: str, max_a
     else:
         draw_vehicle(ax, vehicle, unit=unit)
     lam = modes.eigenvalues[index]
-    ax.set_title(f"{title}: lambda = {lam.real:.3f} {'+' if lam.imag >= 0 else '-'} {abs(lam.imag):.3f}i 1/s, "
-                 f"f_d = {modes.damped_frequency_hz[index]:.3f} Hz, zeta = {modes.damping_ratio[index]:.3f}\n"
+    ax.set_title(f"{title}: λ = {lam.real:.3f} {'+' if lam.imag >= 0 else '−'} {abs(lam.imag):.3f}i 1/s, "
+                 f"f_d = {modes.damped_frequency_hz[index]:.3f} Hz, ζ = {modes.damping_ratio[index]:.3f}\n"
                  f"(phases 0/90/180/270 deg, largest articulation {max_angle_deg:g} deg)", fontsize=SMALL_PT + 0.5)
     _top_view_axes(ax, unit)
     return fig
@@ -247,43 +249,58 @@ def fig_free_body(vehicle: Vehicle, title: str, unit: str = "in") -> Figure:
     n = vehicle.n_units
     rows = 1 if n <= 2 else 2
     per_row = int(np.ceil(n / rows))
-    fig, axes = new_figure(PAGE_WIDTH_IN, 2.6 * rows, nrows=rows)
+    fig, axes = new_figure(PAGE_WIDTH_IN, 2.9 * rows, nrows=rows)
     axes = np.atleast_1d(axes)
-    gap = 2.3
     poses = unit_poses(vehicle)
     for r, ax in enumerate(axes):
         ks = range(r * per_row, min(n, (r + 1) * per_row))
         if not len(ks):
             continue
-        shift = -poses[ks[0]][0][0]
+        # pull every unit back from the one ahead until their bodies are 1 m apart
+        x_cg, x = {}, 0.0
+        for k in ks:
+            if k == ks[0]:
+                x = 0.0
+            else:
+                rear_ahead = x_cg[k - 1] + body_extent(vehicle, k - 1)[1]
+                x = min(poses[k][0][0] - poses[k - 1][0][0] + x_cg[k - 1], rear_ahead - 1.0 -
+                        body_extent(vehicle, k)[0])
+            x_cg[k] = x
         for k in ks:
             u = vehicle.units[k]
-            cg = np.array([poses[k][0][0] + shift - gap * (k - ks[0]), 0.0])
+            cg = np.array([x_cg[k], 0.0])
             draw_unit(ax, vehicle, k, cg, 0.0, labels=False, unit=unit)
             ax.add_patch(FancyArrowPatch(f * cg, f * (cg + (1.1, 0)), arrowstyle="-|>", mutation_scale=7, color="#333"))
             ax.add_patch(FancyArrowPatch(f * cg, f * (cg + (0, 0.95)), arrowstyle="-|>", mutation_scale=7,
                                          color="#333"))
             ax.annotate(f"u, v{k + 1}, r{k + 1}", f * cg, xytext=(4, 4), textcoords="offset points",
                         fontsize=SMALL_PT)
-            for a in u.axles:
+            previous = None
+            for a in sorted(u.axles, key=lambda a: -a.x_m):
                 p = cg + (a.x_m, 0)
-                ax.add_patch(FancyArrowPatch(f * (p + (0, -2.0)), f * (p + (0, -1.2)), arrowstyle="-|>",
+                # an axle close behind the previous one gets its label one step further out
+                far = previous is not None and previous[0] - a.x_m < 1.6 and not previous[1]
+                top = -2.0 - (0.75 if far else 0.0)
+                ax.add_patch(FancyArrowPatch(f * (p + (0, top)), f * (p + (0, -1.2)), arrowstyle="-|>",
                                              mutation_scale=7, color="blue"))
-                ax.annotate(f"F{a.name}, P{a.name}\nM{a.name}, T{a.name}", f * (p + (0, -2.05)), ha="center",
+                ax.annotate(f"F{a.name}, P{a.name}\nM{a.name}, T{a.name}", f * (p + (0, top - 0.05)), ha="center",
                             fontsize=SMALL_PT, color="blue")
+                previous = (a.x_m, far)
             if k > 0:
                 p = cg + (u.front_coupling_m, 0)
                 ax.add_patch(FancyArrowPatch(f * (p + (0, 1.8)), f * (p + (0, 1.15)), arrowstyle="-|>",
                                              mutation_scale=7, color="green"))
-                ax.annotate(f"F{joint_letter(k - 1)}", f * (p + (0, 2.05)), ha="center", fontsize=SMALL_PT,
-                            color="green")
+                ax.annotate(f"F{joint_letter(k - 1)}", f * (p + (0, 2.05)), ha="center", va="top",
+                            fontsize=SMALL_PT, color="green")
             if k < n - 1:
                 p = cg + (u.rear_coupling_m, 0)
                 ax.add_patch(FancyArrowPatch(f * (p + (0, 1.15)), f * (p + (0, 1.8)), arrowstyle="-|>",
                                              mutation_scale=7, color="green"))
-                ax.annotate(f"F{joint_letter(k)}", f * (p + (0, 2.05)), ha="center", fontsize=SMALL_PT,
-                            color="green")
+                ax.annotate(f"F{joint_letter(k)}", f * (p + (0, 2.05)), ha="center", va="top",
+                            fontsize=SMALL_PT, color="green")
         _top_view_axes(ax, unit, ylim_m=2.6)
+        f_unit = 1.0 / LENGTH_UNITS[unit]
+        ax.set_ylim(2.7 * f_unit, -4.1 * f_unit)
     axes[0].set_title(title, fontsize=8)
     return fig
 
@@ -412,7 +429,7 @@ def plot_time_response(response, signals=None, ax=None, **style) -> Figure:
         fig, ax = new_figure(PAGE_WIDTH_IN, 3.2)
     else:
         fig = ax.figure
-    units = {"v": "m/s", "r": "rad/s", "t": "rad", "y": "m", "Y": "m", "a": "m/s^2", "p": "rad"}
+    units = {"v": "m/s", "r": "rad/s", "t": "rad", "y": "m", "Y": "m", "a": "m/s²", "p": "rad"}
     for i, name in enumerate(names):
         kw = {"color": PALETTE[i % len(PALETTE)], "lw": 1.1}
         kw.update(style)
@@ -440,7 +457,7 @@ def plot_single_sine(ss, ax=None) -> Figure:
     ax2.set_ylabel("steer angle [deg] (dotted)")
     ax2.tick_params(labelsize=SMALL_PT)
     ax.set_xlabel("time [s]")
-    ax.set_ylabel("lateral acceleration [m/s^2]")
+    ax.set_ylabel("lateral acceleration [m/s²]")
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=SMALL_PT, ncol=2, loc="lower right")
     return fig

@@ -18,6 +18,7 @@ from __future__ import annotations
 import csv
 import html
 import math
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, Iterable
 
@@ -27,17 +28,23 @@ from .plotting import figure_data
 
 #: unit suffixes of column names -> the unit printed in the header (longest first)
 UNIT_SUFFIXES = (
-    ("_lbf_in_per_rad", "lbf*in/rad"), ("_lbf_s2_per_in", "lbf*s^2/in"), ("_lbf_in_s2", "lbf*in*s^2"),
-    ("_lbf_per_rad", "lbf/rad"), ("_N_per_rad", "N/rad"), ("_Nm_per_rad", "N*m/rad"), ("_kg_m2", "kg*m^2"),
-    ("_m_per_s2_per_rad", "m/s^2/rad"), ("_m_per_s2", "m/s^2"), ("_rad_per_s", "rad/s"), ("_m_per_s", "m/s"),
+    ("_lbf_in_per_rad", "lbf·in/rad"), ("_lbf_s2_per_in", "lbf·s²/in"), ("_lbf_in_s2", "lbf·in·s²"),
+    ("_lbf_per_rad", "lbf/rad"), ("_N_per_rad", "N/rad"), ("_Nm_per_rad", "N·m/rad"), ("_kg_m2", "kg·m²"),
+    ("_m_per_s2_per_rad", "m/s²/rad"), ("_m_per_s2", "m/s²"), ("_rad_per_s", "rad/s"), ("_m_per_s", "m/s"),
     ("_per_s", "1/s"), ("_percent", "%"), ("_lbf", "lbf"), ("_mph", "mph"), ("_kph", "km/h"), ("_deg", "deg"),
-    ("_rad", "rad"), ("_hz", "Hz"), ("_Nm", "N*m"), ("_kg", "kg"), ("_in", "in"), ("_m", "m"), ("_s", "s"),
+    ("_mrad", "mrad"), ("_rad", "rad"), ("_hz", "Hz"), ("_mm", "mm"), ("_Nm", "N·m"), ("_kg", "kg"), ("_in", "in"), ("_m", "m"), ("_s", "s"),
     ("_N", "N"),
 )
-#: text width of the PDF page, in characters of the table font (footnotesize, portrait)
-PORTRAIT_CHARS = 104
+#: text width of the PDF page [pt]: US letter with 2 cm margins (the lcvlatex template), portrait
+PORTRAIT_LINE_PT = 500.0
 #: and on a landscape page
-LANDSCAPE_CHARS = 150
+LANDSCAPE_LINE_PT = 675.0
+#: cell values that stand for "no number" in a numeric column
+BLANKS = ("", None, "none", "-")
+#: a one-row table with more columns than this is shown transposed (quantity, value)
+TRANSPOSE_COLUMNS = 5
+#: tables up to this many rows are set as one block with their caption (longer ones break over pages)
+MAX_UNBROKEN_ROWS = 40
 
 
 def setup(data_dir: str | Path | None) -> Path | None:
@@ -59,6 +66,23 @@ def setup(data_dir: str | Path | None) -> Path | None:
     path = Path(data_dir).expanduser().resolve()
     path.mkdir(parents=True, exist_ok=True)
     return path
+
+
+@lru_cache(maxsize=2)
+def _font(bold: bool):
+    from matplotlib import font_manager, ft2font
+    prop = font_manager.FontProperties(family="DejaVu Serif", weight="bold" if bold else "normal")
+    return ft2font.FT2Font(font_manager.findfont(prop, fallback_to_default=True))
+
+
+def text_width_pt(text: str, size_pt: float = 8.0, bold: bool = False) -> float:
+    """Width of ``text`` set in DejaVu Serif (the PDF's font) at ``size_pt`` [pt]."""
+    if not text:
+        return 0.0
+    font = _font(bold)
+    font.set_size(size_pt, 72)
+    font.set_text(text, 0.0)
+    return font.get_width_height()[0] / 64.0
 
 
 def header_label(column: str) -> str:
@@ -101,8 +125,12 @@ def fmt(value: Any, digits: int = 4) -> str:
             return "0"
         if not math.isfinite(value):
             return str(value)
-        text = f"{value:.{digits}g}"
-        return text.replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
+        if 1e-3 <= abs(value) < 1e6:   # fixed point: `digits` significant digits, integers whole
+            decimals = max(0, digits - 1 - math.floor(math.log10(abs(value))))
+            return f"{value:.{decimals}f}"
+        text = f"{value:.{digits - 1}e}"
+        mantissa, exponent = text.split("e")
+        return f"{mantissa}e{int(exponent)}"
     return str(value)
 
 
@@ -138,56 +166,105 @@ class Table:
         self.number, self.caption, self.rows, self.digits = number, caption, rows, digits
         self.columns = list(columns) if columns is not None else (list(rows[0].keys()) if rows else [])
         self.cells = [[fmt(r.get(c, ""), digits) for c in self.columns] for r in rows]
-        self.numeric = [bool(rows) and all(_is_number(r.get(c)) for r in rows) for c in self.columns]
+        # a numeric column: numbers, or blanks where a row has none (a coupling that does not exist)
+        self.numeric = [any(_is_number(r.get(c)) for r in rows) and
+                        all(_is_number(r.get(c)) or r.get(c) in BLANKS for r in rows) for c in self.columns]
         self.headers = [header_label(c) for c in self.columns]
+        if len(rows) == 1 and len(self.columns) > TRANSPOSE_COLUMNS:
+            # one row of many columns reads better as a list of quantities
+            values = [rows[0].get(c, "") for c in self.columns]
+            self.cells = [[h, fmt(v, digits)] for h, v in zip(self.headers, values)]
+            self.numeric = [False, all(_is_number(v) or v in BLANKS for v in values)]
+            self.headers = ["quantity", "value"]
 
     # --------------------------------------------------------------- layout
-    def _widths(self) -> tuple[list[float], bool, str]:
-        """Column widths as fractions of the line width, landscape or not, font size."""
-        natural = []
-        for k in range(len(self.columns)):
-            longest_word = max([len(w) for w in self.headers[k].split()] or [1])
-            body = max([len(row[k]) for row in self.cells] or [1])
-            if self.numeric[k]:
-                natural.append(max(body, longest_word, 3) + 1)
+    def _header_lines(self, k: int, width_pt: float, size_pt: float) -> list[str]:
+        """The header of column ``k`` broken between words into lines no wider than
+        ``width_pt`` (a word wider than that stays whole: never letter by letter)."""
+        lines: list[str] = []
+        for word in self.headers[k].split():
+            if lines and text_width_pt(lines[-1] + " " + word, size_pt, bold=True) <= width_pt:
+                lines[-1] += " " + word
             else:
-                natural.append((max(longest_word, 6) + 1, max(body, len(self.headers[k])) + 1))
-        fixed = sum(w for w in natural if not isinstance(w, tuple))
-        text_min = sum(w[0] for w in natural if isinstance(w, tuple))
-        text_full = sum(w[1] for w in natural if isinstance(w, tuple))
-        for chars, landscape, size in ((PORTRAIT_CHARS, False, "footnotesize"),
-                                       (LANDSCAPE_CHARS, True, "footnotesize"),
-                                       (LANDSCAPE_CHARS * 1.2, True, "scriptsize")):
-            if fixed + text_min <= chars:
+                lines.append(word)
+        return lines or [""]
+
+    def _layout(self) -> tuple[list[float], bool, float, float]:
+        """Column widths [pt] (numbers: their natural width, text: a paragraph width),
+        whether the table needs a landscape page, the font size [pt] and the space
+        between columns [pt].  Widths are measured with the PDF's font (DejaVu Serif)."""
+        for line_pt, landscape, size in ((PORTRAIT_LINE_PT, False, 8.0), (LANDSCAPE_LINE_PT, True, 8.0),
+                                         (LANDSCAPE_LINE_PT, True, 7.0)):
+            natural, text_min, text_full = [], 0.0, 0.0
+            for k in range(len(self.headers)):
+                words = self.headers[k].split() or [""]
+                head_word = max(text_width_pt(w, size, bold=True) for w in words)
+                body_full = max([text_width_pt(row[k], size) for row in self.cells] or [0.0])
+                if self.numeric[k]:
+                    natural.append(max(body_full, head_word, 2 * size))
+                    continue
+                body_word = max([text_width_pt(w, size) for row in self.cells for w in row[k].split()] or [0.0])
+                full = max(body_full, text_width_pt(self.headers[k], size, bold=True), 2 * size)
+                low = min(full, max(head_word, body_word, 6 * size))
+                natural.append((low, full))
+                text_min += low
+                text_full += full
+            fixed = sum(w for w in natural if not isinstance(w, tuple))
+            gap = 5.0 if fixed + text_full + 10.0 * len(natural) <= line_pt else 3.0
+            room = line_pt - fixed - 2 * gap * len(natural)
+            # portrait when the text columns get at least 40 % of the width they would like
+            # beyond their minimum
+            share = (room - text_min) / (text_full - text_min) if text_full > text_min else 1.0
+            if text_min <= room and (share >= 0.4 or size < 8.0):
                 break
-        spare = max(chars - fixed, text_min)
-        widths = []
-        for w in natural:
-            if isinstance(w, tuple):
-                share = w[1] / text_full if text_full else 0.0
-                widths.append(max(w[0], min(w[1], spare * share if fixed + text_full > chars else w[1])))
-            else:
-                widths.append(w)
-        total = sum(widths)
-        scale = min(1.0, chars / total) if total else 1.0
-        return [w * scale / chars for w in widths], landscape, size
+        # text columns: their minimum width, plus a share of what is left in proportion to
+        # how much more they would need (the table never exceeds the line when it can)
+        spare, need = room - text_min, text_full - text_min
+        widths = [w if not isinstance(w, tuple) else
+                  w[0] + (w[1] - w[0]) * (min(1.0, max(spare, 0.0) / need) if need > 0 else 0.0) for w in natural]
+        return widths, landscape, size, gap
 
     # --------------------------------------------------------------- renderers
     def _repr_latex_(self) -> str:
-        if not self.columns:
-            return rf"\textbf{{Table {_latex_escape(self.number)}.}} {_latex_escape(self.caption)} (no rows)"
-        widths, landscape, size = self._widths()
-        spec = "".join((r">{\raggedleft\arraybackslash}p{%.3f\linewidth}" if num else
-                        r">{\raggedright\arraybackslash}p{%.3f\linewidth}") % max(w - 0.025, 0.02)
-                       for w, num in zip(widths, self.numeric))
-        head = " & ".join(r"\textbf{%s}" % _latex_escape(h) for h in self.headers) + r" \\"
-        body = "\n".join(" & ".join(_latex_escape(c) for c in row) + r" \\" for row in self.cells)
+        """Numbers in right-aligned columns of their natural width (a number never
+        breaks), text in ragged paragraph columns, headers broken between words, the
+        caption above; one block up to :data:`MAX_UNBROKEN_ROWS` rows, else a longtable;
+        on a landscape page when the columns need it."""
         cap = rf"\textbf{{Table {_latex_escape(self.number)}.}} {_latex_escape(self.caption)}"
-        lines = [r"\begin{landscape}" if landscape else "", "{\\" + size, r"\setlength{\tabcolsep}{0.0125\linewidth}",
-                 rf"\begin{{longtable}}{{{spec}}}", rf"\caption*{{{cap}}}\\", r"\toprule", head, r"\midrule",
-                 r"\endfirsthead", r"\toprule", head, r"\midrule", r"\endhead", body, r"\bottomrule",
-                 r"\end{longtable}}", r"\end{landscape}" if landscape else ""]
-        return "\n".join(line for line in lines if line)
+        if not self.headers:
+            return cap + " (no rows)"
+        widths, landscape, size, gap = self._layout()
+        spec = "".join("r" if num else r">{\raggedright\arraybackslash}p{%.1fpt}" % w
+                       for w, num in zip(widths, self.numeric))
+        heads = []
+        for k, (w, num) in enumerate(zip(widths, self.numeric)):
+            if num:
+                lines = [_latex_escape(line) for line in self._header_lines(k, w, size)]
+                heads.append(r"\begin{tabular}[b]{@{}r@{}}\textbf{%s}\end{tabular}"
+                             % r"}\\\textbf{".join(lines))
+            else:
+                heads.append(r"\textbf{%s}" % _latex_escape(self.headers[k]))
+        head = " & ".join(heads) + r" \\"
+        body = "\n".join(" & ".join(_latex_escape(c) for c in row) + r" \\" for row in self.cells)
+        n = len(self.headers)
+        font = r"\fontsize{%g}{%g}\selectfont" % (size, size + 1.5)
+        setup = [font, r"\setlength{\tabcolsep}{%gpt}" % gap]
+        if len(self.cells) <= MAX_UNBROKEN_ROWS:
+            # one unbreakable block: the caption never leaves its table
+            lines = [r"\par\medskip\noindent\begin{minipage}{\linewidth}", r"{\raggedright " + cap + r"\par}",
+                     r"\smallskip{", *setup, rf"\begin{{tabular}}{{@{{}}{spec}@{{}}}}", r"\toprule", head,
+                     r"\midrule", body, r"\bottomrule", r"\end{tabular}}", r"\end{minipage}\par\medskip"]
+        else:
+            # a long table breaks over pages, its header repeated
+            lines = [r"\par\medskip\noindent{\raggedright " + cap + r"\par}", "{", *setup,
+                     r"\setlength{\LTpre}{2pt}\setlength{\LTleft}{0pt}\setlength{\LTright}{\fill}",
+                     rf"\begin{{longtable}}{{@{{}}{spec}@{{}}}}", r"\toprule", head, r"\midrule", r"\endfirsthead",
+                     rf"\multicolumn{{{n}}}{{@{{}}l}}{{\normalsize\textbf{{Table {_latex_escape(self.number)}}} "
+                     r"(continued)}\\[2pt]",
+                     r"\toprule", head, r"\midrule", r"\endhead", body, r"\bottomrule", r"\end{longtable}}"]
+        if landscape:
+            lines = [r"\begin{landscape}", *lines, r"\end{landscape}"]
+        return "\n".join(lines)
 
     def _repr_html_(self) -> str:
         align = ["right" if n else "left" for n in self.numeric]
@@ -216,14 +293,14 @@ def show_figure(fig, number: str, caption: str, data_dir: str | Path | None) -> 
 
 
 def show_table(number: str, caption: str, rows: list[dict], data_dir: str | Path | None, digits: int = 4,
-               columns: Iterable[str] | None = None) -> Table:
-    """Display ``rows`` as a :class:`Table` under ``Table <number>. <caption>``; save CSV."""
+               columns: Iterable[str] | None = None) -> None:
+    """Display ``rows`` as a :class:`Table` under ``Table <number>. <caption>``; save CSV.
+
+    Returns None, so a call ending a notebook cell does not display the table twice."""
     from IPython.display import display
     if data_dir is not None:
         write_csv(Path(data_dir) / f"table_{_slug(number)}.csv", rows)
-    table = Table(number, caption, rows, digits, columns)
-    display(table)
-    return table
+    display(Table(number, caption, rows, digits, columns))
 
 
 def matrix_rows(matrix, row_names: list[str], col_names: list[str]) -> list[dict]:
