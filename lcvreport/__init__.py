@@ -9,7 +9,9 @@ Where things live (the folders are the layers; each imports only the ones above 
 ----------------------------------------------------------------------------------
 ``units``, ``ranges``    conversion factors and unit systems; the one table of valid
                          ranges of every parameter and input
-``util/``                an LRU cache; numpy-only numerics (equilibrated solve, expm)
+``util/``                helpers with no physics:
+    ``cache``            an LRU cache (discretizations, output maps)
+    ``numerics``         numpy-only numerics: equilibrated solve, expm
 ``model/``               **the model core** (numpy only):
     ``vehicle``          Axle, Unit, Vehicle (SI parameter sets, validated)
     ``vehicle_file``     vehicle files (TOML, SI): load_vehicle, dumps_vehicle
@@ -25,16 +27,27 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``modal``            modal superposition, exact and the thesis' method
     ``statespace``       named state space; to_statespace (python-control)
     ``measures``         RA, damping, critical speed, single sine, trim
-``thesis/``              **the reproduction of the dissertation**: its tables (data),
-                         tire fits, the preset conversion, chapter studies, audit
-``fmu/``                 **the FMUs**: interface table, modelDescription writer, the
-                         co-simulation engine (numpy only), builders of the pythonfmu
-                         and the C FMU (sources in the repository's ``fmu_src/``,
-                         installed as ``lcvreport.fmu_src``)
-``report/``              **the reports**: plotting, captions and tables, papermill +
-                         nbconvert orchestration of the thesis report and of the
-                         assessment report of any vehicle (notebooks in ``notebooks/``,
-                         installed as ``lcvreport.notebooks``)
+    ``closed_loop``      sampled steering feedback (what a co-simulation computes)
+``thesis/``              **the reproduction of the dissertation**:
+    ``tables``           its tables and gaps (data files in ``data/thesis``)
+    ``tires``            cubic fits of the tire coefficients against load
+    ``vehicles``         the presets built from the tables, as vehicle files
+    ``configurations``   per-tire residual forces (Figures 3-6..3-8, 4-9..4-11)
+    ``studies``          the chapter III-V runs, in both readings
+    ``audit``            every published number against its recomputation
+``fmu/``                 **the FMUs**:
+    ``interface``        the one interface table (SPEC sections 5 and 9)
+    ``model_description`` modelDescription.xml from that table
+    ``engine``           the co-simulation engine (numpy only)
+    ``slave``            the pythonfmu slave class, a thin map onto the engine
+    ``build``            builders of the pythonfmu and the C FMU (sources in the
+                         repository's ``fmu_src/``, installed as ``lcvreport.fmu_src``)
+``report/``              **the reports** (notebooks in ``notebooks/``, installed as
+                         ``lcvreport.notebooks``):
+    ``plotting``         figures (matplotlib), units on every axis
+    ``reporting``        captions, tables (HTML, LaTeX), CSV of every table and figure
+    ``assessment``       what the assessment report of one vehicle shows
+    ``build``            papermill + nbconvert: the thesis report, the assessment report
 ``cli``                  the ``lcv`` command
 
 Units

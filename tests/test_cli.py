@@ -204,13 +204,21 @@ def test_static_load_missing_for_the_1_percent_rule_is_named(tmp_path, capsys):
 
 # ---------------------------------------------------------------------------- outputs that cannot be written
 def test_broken_pipe_ends_quietly():
-    """`lcv presets | head -1` and `lcv simulate ... | head -1`: no message, status 141 (as SIGPIPE)."""
+    """A reader that has gone away: no message, status 141 (as SIGPIPE), for a short
+    output (the pipe's reading end closed before lcv starts) and for a long one
+    (`lcv simulate ... | head -1`)."""
     exe = shutil.which("lcv", path=os.path.dirname(sys.executable))
-    for cmd in (f"{exe} presets | head -1",
-                f"{exe} simulate --preset aucnat --speed-mph 50 --load trailer3 --t-end 3600 --dt 0.001 | head -1"):
-        p = subprocess.run(["bash", "-c", f"set -o pipefail; {cmd}"], capture_output=True, text=True, timeout=120)
-        assert p.stderr == "", p.stderr
-        assert p.returncode == EXIT_BROKEN_PIPE and len(p.stdout.splitlines()) == 1
+    r, w = os.pipe()
+    os.close(r)
+    try:
+        p = subprocess.run([exe, "presets"], stdout=w, stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(w)
+    assert p.stderr == "" and p.returncode == EXIT_BROKEN_PIPE, (p.returncode, p.stderr)
+    cmd = f"{exe} simulate --preset aucnat --speed-mph 50 --load trailer3 --t-end 3600 --dt 0.001 | head -1"
+    p = subprocess.run(["bash", "-c", f"set -o pipefail; {cmd}"], capture_output=True, text=True, timeout=120)
+    assert p.stderr == "", p.stderr
+    assert p.returncode == EXIT_BROKEN_PIPE and len(p.stdout.splitlines()) == 1
 
 
 def test_full_disk_is_one_line_and_exit_1():

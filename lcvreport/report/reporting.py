@@ -43,8 +43,9 @@ LANDSCAPE_LINE_PT = 675.0
 BLANKS = ("", None, "none", "-")
 #: a one-row table with more columns than this is shown transposed (quantity, value)
 TRANSPOSE_COLUMNS = 5
-#: tables up to this many rows are set as one block with their caption (longer ones break over pages)
-MAX_UNBROKEN_ROWS = 40
+#: a table up to this height [pt] is set as one block with its caption (taller ones break
+#: over pages): 60 % of the text height of a portrait page, or of a landscape page's
+UNBROKEN_HEIGHT_PT = {False: 0.6 * 678.0, True: 0.6 * PORTRAIT_LINE_PT}
 
 
 def setup(data_dir: str | Path | None) -> Path | None:
@@ -224,11 +225,20 @@ class Table:
                   w[0] + (w[1] - w[0]) * (min(1.0, max(spare, 0.0) / need) if need > 0 else 0.0) for w in natural]
         return widths, landscape, size, gap
 
+    def _height_pt(self, widths: list[float], size: float) -> float:
+        """Estimated height of the table body and header [pt]: a row is as many lines as
+        its most wrapped text cell."""
+        lines = 0
+        for row in self.cells:
+            lines += max([1] + [math.ceil(1.15 * text_width_pt(c, size) / w) for c, w, num
+                                in zip(row, widths, self.numeric) if not num and w > 0])
+        return (lines + 4) * (size + 1.5)
+
     # --------------------------------------------------------------- renderers
     def _repr_latex_(self) -> str:
         """Numbers in right-aligned columns of their natural width (a number never
         breaks), text in ragged paragraph columns, headers broken between words, the
-        caption above; one block up to :data:`MAX_UNBROKEN_ROWS` rows, else a longtable;
+        caption above; one block up to :data:`UNBROKEN_HEIGHT_PT`, else a longtable;
         on a landscape page when the columns need it."""
         cap = rf"\textbf{{Table {_latex_escape(self.number)}.}} {_latex_escape(self.caption)}"
         if not self.headers:
@@ -249,7 +259,7 @@ class Table:
         n = len(self.headers)
         font = r"\fontsize{%g}{%g}\selectfont" % (size, size + 1.5)
         setup = [font, r"\setlength{\tabcolsep}{%gpt}" % gap]
-        if len(self.cells) <= MAX_UNBROKEN_ROWS:
+        if self._height_pt(widths, size) <= UNBROKEN_HEIGHT_PT[landscape]:
             # one unbreakable block: the caption never leaves its table
             lines = [r"\par\medskip\noindent\begin{minipage}{\linewidth}", r"{\raggedright " + cap + r"\par}",
                      r"\smallskip{", *setup, rf"\begin{{tabular}}{{@{{}}{spec}@{{}}}}", r"\toprule", head,

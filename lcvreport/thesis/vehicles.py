@@ -19,7 +19,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..model.vehicle import Axle, Unit, Vehicle
+from ..model.vehicle import Axle, Unit, Vehicle, joint_letter
 from ..model.vehicle_file import dumps_vehicle
 from ..units import M_PER_IN, N_PER_LBF, THESIS
 from .tables import dimensions, gaps, mass_table, tire_table
@@ -68,7 +68,6 @@ def preset_from_tables(name: str) -> Vehicle:
     n_steer, n_other = g["tires_per_axle"]["steer"], g["tires_per_axle"]["other"]
     n_tandem = g["tandem"]["axles"]
     D_m = g["dual_spacing"]["D_in"] * M_PER_IN
-    letters = "ABCDE"
     units = []
 
     def axle(aname, x_in, row, n_tires, load_lbf, steered=False, dual=True):
@@ -80,8 +79,8 @@ def preset_from_tables(name: str) -> Vehicle:
 
     for k, uname in enumerate(UNIT_NAMES[:n_units]):
         i = k + 1
-        front = None if k == 0 else dims[f"x{i}{letters[k - 1]}_in"] * M_PER_IN
-        rear = None if k == n_units - 1 else -dims[f"x{i}{letters[k]}_in"] * M_PER_IN
+        front = None if k == 0 else dims[f"x{i}{joint_letter(k - 1)}_in"] * M_PER_IN
+        rear = None if k == n_units - 1 else -dims[f"x{i}{joint_letter(k)}_in"] * M_PER_IN
         rear_end = None
         if k == n_units - 1:  # x2B for the tractor-semitrailer (eq. 3.43), x6F for the triple (eq. 4.46)
             rear_end = -(dims["x2B_in"] if n_units == 2 else g["rear_end"]["x6F_in"]) * M_PER_IN
@@ -114,7 +113,6 @@ def preset_file_text(name: str) -> str:
               f"Tractor tandem: {g['tandem']['source']}\n"
               "Steer axle 11: single tires, no dual term (C_S = 0, D = 0).")
     dims, mass, tires = dimensions(config), mass_table(config), tire_table(config)
-    letters = "ABCDE"
     unit_comments, axle_comments = {}, {}
     for k, u in enumerate(v.units):
         i, row = k + 1, mass[_ROW[u.name]]
@@ -122,9 +120,9 @@ def preset_file_text(name: str) -> str:
                  f"{row['inertia_lbf_in_s2']:g} lbf*in*s^2 ({mass['table']})"]
         joints = []
         if k > 0:
-            joints.append(f"front x{i}{letters[k - 1]} = {dims[f'x{i}{letters[k - 1]}_in']:g} in")
+            joints.append(f"front x{i}{joint_letter(k - 1)} = {dims[f'x{i}{joint_letter(k - 1)}_in']:g} in")
         if k < n_units - 1:
-            joints.append(f"rear x{i}{letters[k]} = {dims[f'x{i}{letters[k]}_in']:g} in")
+            joints.append(f"rear x{i}{joint_letter(k)} = {dims[f'x{i}{joint_letter(k)}_in']:g} in")
         elif n_units == 2:
             joints.append(f"rear end x2B = {dims['x2B_in']:g} in (eq. 3.43)")
         else:

@@ -1,0 +1,73 @@
+"""Benchmark: the whole SPEC section 8 measure set per (vehicle, speed).
+
+For every preset and example vehicle at 88 km/h: ``measure_set`` (least damping,
+critical speed, RA in the frequency domain, the exact single sine, the gains, the trim
+under the 1 % rule on the rearmost unit), timed beside the bare eigenvalue call
+(``numpy.linalg.eigvals``) of the same state matrix, and the time of each part, to say
+which one dominates.  Best of ``REPEATS``.  Target (issue "measures"): <= 20 ms per
+(vehicle, speed) for a 6-unit train on this machine.
+
+    python benchmarks/measures.py
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from lcvreport import load_preset, load_vehicle
+from lcvreport.analysis import measures
+from lcvreport.analysis.modes import state_matrix
+from lcvreport.model.loads import load_vector, one_percent_rule
+from lcvreport.model.presets import PRESETS
+from lcvreport.units import kph_to_mps
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEED_MPS = kph_to_mps(88.0)
+REPEATS = 7
+
+
+def best(fn, repeats: int = REPEATS) -> float:
+    """Best wall time of ``fn()`` [s]."""
+    fn()
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def main() -> None:
+    vehicles = [load_preset(p) for p in PRESETS] + [load_vehicle(p) for p in
+                                                    sorted((ROOT / "examples" / "vehicles").glob("*.toml"))]
+    print(f"measure set at 88 km/h, best of {REPEATS} [ms]")
+    header = (f"{'vehicle':22s} {'units':>5s} {'states':>6s} {'bare eig':>9s} {'measures':>9s} {'ratio':>6s}  "
+              f"{'damping':>8s} {'critical':>8s} {'RA(f)':>7s} {'1-sine':>7s} {'trim':>7s}  dominant")
+    print(header)
+    worst_six = 0.0
+    for v in vehicles:
+        load = [v.unit_names[-1]]
+        A = state_matrix(v, SPEED_MPS)
+        F = load_vector(v, one_percent_rule(v, load))
+        t_bare = best(lambda: np.linalg.eigvals(A))
+        t_all = best(lambda: measures.measure_set(v, SPEED_MPS, load_units=load))
+        parts = {
+            "damping": best(lambda: measures.least_damping(v, SPEED_MPS)),
+            "critical": best(lambda: measures.critical_speed(v)),
+            "RA(f)": best(lambda: measures.steer_to_acceleration(v, SPEED_MPS, measures.RA_FREQUENCY_HZ)),
+            "1-sine": best(lambda: measures.single_sine(v, SPEED_MPS)),
+            "trim": best(lambda: measures.trim(v, SPEED_MPS, F)),
+        }
+        dominant = max(parts, key=parts.get)
+        if v.n_units == 6:
+            worst_six = max(worst_six, t_all)
+        print(f"{v.name:22s} {v.n_units:5d} {v.n_states:6d} {t_bare * 1e3:9.3f} {t_all * 1e3:9.2f} "
+              f"{t_all / t_bare:6.0f}  " + " ".join(f"{parts[k] * 1e3:{8 if i < 2 else 7}.2f}"
+                                                   for i, k in enumerate(parts)) + f"  {dominant}")
+    print(f"slowest 6-unit vehicle: {worst_six * 1e3:.2f} ms per (vehicle, speed)  (target <= 20 ms)")
+
+
+if __name__ == "__main__":
+    main()

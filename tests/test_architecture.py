@@ -1,0 +1,156 @@
+"""The package's shape: the folders are layers that import only downward, the package
+map in ``lcvreport/__init__.py`` names every module, the FMU runtime stays numpy-only,
+the C sources and notebooks are package data, and facts have one source."""
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from importlib import resources
+from pathlib import Path
+
+import pytest
+
+import lcvreport
+
+PACKAGE = Path(lcvreport.__file__).resolve().parent
+#: the layers, lowest first: a module may import its own layer and the ones before it
+LAYERS = ["units", "ranges", "util", "model", "analysis", "thesis", "fmu", "report", "cli"]
+#: imports of a higher layer allowed inside a function only (never at import time):
+#: results that plot themselves (as python-control's), and the presets' optional thesis
+#: masses (``load_preset(name, masses="unrounded")``)
+LAZY_UPWARD = {
+    ("analysis.measures", "report.plotting"), ("analysis.response", "report.plotting"),
+    ("thesis.studies", "report.plotting"), ("model.presets", "thesis.vehicles"),
+}
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for p in sorted(PACKAGE.rglob("*.py")):
+        rel = p.relative_to(PACKAGE).with_suffix("")
+        parts = [x for x in rel.parts if x != "__init__"]
+        out[".".join(parts)] = p
+    return out
+
+
+def _imports(path: Path, module: str) -> list[tuple[str, bool]]:
+    """(imported lcvreport module relative to the package, inside a function?)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    package = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
+    out = []
+
+    def visit(node, in_function):
+        for child in ast.iter_child_nodes(node):
+            nested = in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef))
+            if isinstance(child, ast.ImportFrom):
+                if child.level:
+                    base = package[:len(package) - child.level + 1]
+                    target = ".".join(base + ([child.module] if child.module else []))
+                elif (child.module or "").startswith("lcvreport"):
+                    target = child.module[len("lcvreport."):]
+                else:
+                    target = None
+                if target is not None:
+                    if child.module is None:       # from . import x, y
+                        out.extend((f"{target}.{a.name}".strip("."), nested) for a in child.names)
+                    else:
+                        out.append((target, nested))
+            elif isinstance(child, ast.Import):
+                out.extend((a.name[len("lcvreport."):], nested) for a in child.names
+                           if a.name.startswith("lcvreport."))
+            visit(child, nested)
+
+    visit(tree, False)
+    return out
+
+
+def _layer(module: str) -> str:
+    return module.split(".")[0] if module else ""
+
+
+MODULES = _modules()
+
+
+def test_every_module_belongs_to_a_layer():
+    assert {_layer(m) for m in MODULES if m} <= set(LAYERS), sorted({_layer(m) for m in MODULES} - set(LAYERS))
+
+
+def test_layers_import_only_downward():
+    wrong, lazy = [], set()
+    for module, path in MODULES.items():
+        if not module:
+            continue
+        mine = LAYERS.index(_layer(module))
+        for target, in_function in _imports(path, module):
+            if not target or LAYERS.index(_layer(target)) <= mine:
+                continue
+            pair = (module, ".".join(target.split(".")[:2]))
+            if in_function and pair in LAZY_UPWARD:
+                lazy.add(pair)
+            else:
+                wrong.append((module, target, "in a function" if in_function else "at import"))
+    assert not wrong, wrong
+    assert lazy == LAZY_UPWARD          # the allowance is used, not stale
+
+
+def test_nothing_imports_the_cli():
+    users = [m for m, p in MODULES.items() if m != "cli" and any(t == "cli" for t, _ in _imports(p, m))]
+    assert not users
+
+
+def test_the_package_map_names_every_module():
+    doc = lcvreport.__doc__
+    missing = [m for m in MODULES if m and f"``{m.split('.')[-1]}``" not in doc and f"``{m}/``" not in doc]
+    assert not missing, f"not in the map of lcvreport/__init__.py: {missing}"
+    for folder in ("util", "model", "analysis", "thesis", "fmu", "report"):
+        assert f"``{folder}/``" in doc
+
+
+def test_the_package_and_the_fmu_runtime_load_numpy_only():
+    """``import lcvreport`` and the FMU engine stepping a vehicle never load scipy,
+    matplotlib or python-control (the embedded interpreter of LCV.fmu stays light)."""
+    code = """
+import sys
+import lcvreport
+from lcvreport.fmu.engine import LCVEngine
+from lcvreport.fmu.interface import preset_interface, vehicle_interface
+e = LCVEngine(preset_interface(), preset="aucnat")
+w = e.start_inputs(); w[e.input_index["P61"]] = 1000.0
+for _ in range(5):
+    assert e.step(0.01, w) is None
+e.outputs(w); e.max_real_eig(22.0)
+v = lcvreport.load_vehicle(sys.argv[1])
+e2 = LCVEngine(vehicle_interface(v)); e2.step(0.01, e2.start_inputs())
+heavy = sorted(m for m in sys.modules if m.split(".")[0] in ("scipy", "matplotlib", "control", "pandas"))
+print(",".join(heavy))
+"""
+    vehicle = PACKAGE.parent / "examples" / "vehicles" / "western_double.toml"
+    p = subprocess.run([sys.executable, "-c", code, str(vehicle)], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == "", p.stdout
+
+
+@pytest.mark.parametrize("package, names", [
+    ("lcvreport.fmu_src", ["LCV.py", "c/fmi2_api.c", "c/model.c", "c/linalg.c", "c/loader.c", "c/model_stub.c"]),
+    ("lcvreport.notebooks", [f"{s}.ipynb" for s in ("ch1_2_concepts", "ch3_tractor_semitrailer", "ch4_triple",
+                                                    "ch5_parametric", "appendices", "audit", "assessment")]),
+    ("lcvreport.data", ["vehicles/aucnat.toml", "thesis/published.toml"]),
+])
+def test_build_inputs_are_package_data(package, names):
+    """The FMU sources and the notebooks are found through the installed package,
+    not through the location of a checkout."""
+    root = resources.files(package)
+    for name in names:
+        assert root.joinpath(name).is_file(), f"{package}/{name}"
+
+
+def test_one_source_for_joint_letters_and_ranges():
+    """No module spells out the joint letters or a hard-coded speed limit of its own."""
+    offenders = []
+    for module, path in MODULES.items():
+        text = path.read_text(encoding="utf-8")
+        for literal in ('"ABCDE', "'ABCDE", "JOINT_LETTERS", "LOADABLE_UNITS"):
+            if literal in text:
+                offenders.append((module, literal))
+    assert not offenders, offenders
