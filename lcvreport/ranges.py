@@ -178,3 +178,17 @@ def check_array(key: str, values, name: str | None = None):
         name = name or r.name
         raise RangeError(name, f"{name} must be in {r.text()}, got {bad:.6g}")
     return arr
+
+
+def markdown_table() -> str:
+    """Both tables (:data:`RANGES`, :data:`VEHICLE`) as Markdown, as the README shows them.
+
+    Examples
+    --------
+    >>> markdown_table().splitlines()[2]
+    '| `speed` | [0.1, 70] m/s | forward speed u of every unit |'
+    """
+    rows = ["| quantity | valid (SI) | what |", "|---|---|---|"]
+    for key, r in list(RANGES.items()) + list(VEHICLE.items()):
+        rows.append(f"| `{key}` | {r.text()} | {r.description} |")
+    return "\n".join(rows)
