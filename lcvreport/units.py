@@ -104,8 +104,8 @@ class UnitSystem:
 
     @property
     def inertia_kg_m2(self) -> float:
-        """kg*m^2 per inertia unit (force unit * length unit * s^2)."""
-        return self.force_N * self.length_m
+        """kg*m^2 per inertia unit (force unit * length unit * s^2: numerically a moment unit)."""
+        return self.moment_Nm
 
     @property
     def moment_Nm(self) -> float:

@@ -163,7 +163,7 @@ class SingleSine:
     Attributes
     ----------
     time : numpy.ndarray, shape (K,)
-        [s]
+        Sample times from the start of the steer [s].
     delta : numpy.ndarray, shape (K,)
         Steer angle held from each sample [rad].
     ay : numpy.ndarray, shape (K, N)

@@ -61,9 +61,9 @@ def modal_response(vehicle: Vehicle, speed_mps: float, F: np.ndarray, time: np.n
     ----------
     vehicle : Vehicle
     speed_mps : float
-        Forward speed [m/s].
+        Forward speed of every unit [m/s].
     F : numpy.ndarray, shape (2N,)
-        Generalized force in ``units``.
+        Generalized force in ``units`` (SI or thesis), held from t = 0.
     time : numpy.ndarray
         Output times [s].
     tire_scale : float

@@ -156,15 +156,18 @@ class LCV(Fmi2Slave):
                     self.inputs[self.input_slot[vr]] = float(value)
                 elif 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].causality == "parameter" \
                         and self.itf.variables[vr].type == "Real":
-                    name = self.itf.variables[vr].name
-                    if self.initialized or self.init_error is not None:
-                        self._error(f"{name} is a fixed parameter: it cannot change after initialization")
-                    else:
-                        self.params[name] = float(value)
+                    self._set_parameter(self.itf.variables[vr].name, float(value))
                 else:
                     self._error(f"fmi2SetReal: {vr} is not the value reference of an input or a Real parameter")
         except Exception as exc:  # noqa: BLE001
             self._error(f"fmi2SetReal failed: {type(exc).__name__}: {exc}")
+
+    def _set_parameter(self, name: str, value) -> None:
+        """A fixed parameter takes a value before initialization ends, never after."""
+        if self.initialized or self.init_error is not None:
+            self._error(f"{name} is a fixed parameter: it cannot change after initialization")
+        else:
+            self.params[name] = value
 
     def get_string(self, vrs):
         out = [""] * len(vrs)
@@ -179,11 +182,7 @@ class LCV(Fmi2Slave):
         try:
             for vr, value in zip(vrs, values):
                 if 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].type == "String":
-                    name = self.itf.variables[vr].name
-                    if self.initialized or self.init_error is not None:
-                        self._error(f"{name} is a fixed parameter: it cannot change after initialization")
-                    else:
-                        self.params[name] = str(value)
+                    self._set_parameter(self.itf.variables[vr].name, str(value))
                 else:
                     self._error(f"fmi2SetString: {vr} is not the value reference of a String variable")
         except Exception as exc:  # noqa: BLE001

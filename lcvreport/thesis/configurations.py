@@ -35,18 +35,9 @@ TRACK_WIDTH_M = 1.8288
 
 @dataclass(frozen=True)
 class TireForce:
-    """Residual force of one tire.
-
-    Attributes
-    ----------
-    axle : str
-    side : str
-        ``curb`` (+y) or ``driver`` (-y).
-    lateral_offset_m : float
-        Tire centre from the unit centreline [m], +y toward the curb.
-    force_N : float
-        Residual lateral force along +y [N].
-    """
+    """Residual force of one tire: on axle ``axle``, side ``side`` (``curb``, +y, or
+    ``driver``, -y), its centre ``lateral_offset_m`` from the unit centreline [m] (+y
+    toward the curb), ``force_N`` along +y [N]."""
 
     axle: str
     side: str

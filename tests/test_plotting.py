@@ -1,0 +1,60 @@
+"""Figures are printable: drawn at most the PDF's text width wide, their smallest text
+at least 7 pt on the page (the PDF places them at their own size), units on the axes."""
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from matplotlib.text import Text  # noqa: E402
+
+from lcvreport import load_preset, load_vehicle, modes  # noqa: E402
+from lcvreport.analysis import measures  # noqa: E402
+from lcvreport.report import plotting  # noqa: E402
+from lcvreport.report.reporting import PORTRAIT_LINE_PT, setup  # noqa: E402
+
+from conftest import EXAMPLES  # noqa: E402
+
+U = 24.4444
+
+
+def _figures():
+    setup(None)
+    aucnat, semi = load_preset("aucnat"), load_preset("tractor_semitrailer")
+    western = load_vehicle(EXAMPLES / "western_double.toml")
+    sweep = measures.speed_sweep(aucnat, np.linspace(10, 130, 13))
+    f = np.linspace(0.1, 2, 20)
+    return {
+        "free body, triple (Figure 4-1)": plotting.fig_free_body(aucnat, "x"),
+        "free body, semi (Figure 3-1)": plotting.fig_free_body(semi, "x"),
+        "vehicle drawing": plotting.fig_vehicle(western, "x"),
+        "mode shape": plotting.fig_mode_shape(aucnat, modes(aucnat, U), 4, "x"),
+        "load configuration": plotting.fig_load_configuration(aucnat, "balanced", "x"),
+        "root locus": plotting.fig_root_locus(sweep.speeds_kph, sweep.eigenvalues, "x"),
+        "damping over speed": plotting.fig_damping_over_speed(sweep.speeds_kph, sweep.least_damping_ratio,
+                                                              sweep.max_real, "x", None, 88.0),
+        "RA curve": plotting.fig_frequency(f, [("RA", np.ones_like(f))], "rearward amplification [-]", "x"),
+        "single sine": measures.single_sine(aucnat, U).plot(),
+        "bars": plotting.fig_bars(["a", "b"], [("g", np.array([1.0, 2.0]))], "y [m]", "x"),
+    }
+
+
+FIGURES = _figures()
+
+
+@pytest.mark.parametrize("name", sorted(FIGURES))
+def test_figure_fits_the_text_width_and_its_text_is_at_least_7_pt(name):
+    fig = FIGURES[name]
+    assert fig.get_size_inches()[0] * 72 <= PORTRAIT_LINE_PT
+    small = sorted({round(t.get_fontsize(), 2) for t in fig.findobj(Text) if t.get_text().strip() and t.get_visible()})
+    assert small and small[0] >= 7.0, (name, small[:3])
+
+
+@pytest.mark.parametrize("name", sorted(FIGURES))
+def test_every_axis_names_its_unit(name):
+    for ax in FIGURES[name].axes:
+        for label in (ax.get_xlabel(), ax.get_ylabel()):
+            if label and ax.get_label() != "<colorbar>":
+                assert "[" in label and "]" in label, (name, label)
