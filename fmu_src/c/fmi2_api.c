@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
+#include "fmi2_shared.h"
 #include "model.h"
 
 /* phases a call is allowed in */
@@ -41,26 +42,16 @@ static const char *phase_name(int phase)
     }
 }
 
-/* The finished text is passed as the message itself, with '%' doubled: hosts that apply
-   printf formatting print it as is, hosts that do not (Python hosts) get the text. */
 static void logmsg(ModelInstance *c, fmi2Status status, const char *fmt, ...)
 {
-    char buf[1200], esc[2400];
+    char esc[2400];
     va_list ap;
-    size_t j = 0;
     if (!c || !c->cb.logger) return;
     if (!c->logging_on && status < fmi2Warning) return;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    format_log_message(esc, sizeof esc, fmt, ap);
     va_end(ap);
-    for (size_t i = 0; buf[i] && j + 2 < sizeof esc; ++i) {
-        if (buf[i] == '%') esc[j++] = '%';
-        esc[j++] = buf[i];
-    }
-    esc[j] = '\0';
-    const char *category = status == fmi2Warning ? "logStatusWarning" : status >= fmi2Error ? "logStatusError"
-                                                                                              : "logAll";
-    c->cb.logger(c->cb.componentEnvironment, c->name, status, category, esc);
+    c->cb.logger(c->cb.componentEnvironment, c->name, status, log_category(status), esc);
 }
 
 /* check the instance and the phase; on failure log and return fmi2Error */
@@ -456,24 +447,3 @@ fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Rea
     return fmi2Discard;
 }
 
-fmi2Status fmi2GetIntegerStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Integer *value)
-{
-    (void)s;
-    if (!comp || !value) return fmi2Error;
-    return fmi2Discard;
-}
-
-fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Boolean *value)
-{
-    (void)s;
-    if (!comp || !value) return fmi2Error;
-    *value = fmi2False;
-    return fmi2Discard;
-}
-
-fmi2Status fmi2GetStringStatus(fmi2Component comp, const fmi2StatusKind s, fmi2String *value)
-{
-    (void)s;
-    if (!comp || !value) return fmi2Error;
-    return fmi2Discard;
-}

@@ -29,6 +29,7 @@
 #include <wchar.h>
 
 #include "fmi2Functions.h"
+#include "fmi2_shared.h"
 #include "loader_config.h"
 
 /* ------------------------------------------------------------------ the forwarded library */
@@ -196,17 +197,11 @@ static void own_logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2St
 
 static void say(Wrapper *w, fmi2Status status, const char *fmt, ...)
 {
-    char buf[1200], esc[2400];
-    size_t j = 0;
+    char esc[2400];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    format_log_message(esc, sizeof esc, fmt, ap);
     va_end(ap);
-    for (size_t i = 0; buf[i] && j + 2 < sizeof esc; ++i) {
-        if (buf[i] == '%') esc[j++] = '%';
-        esc[j++] = buf[i];
-    }
-    esc[j] = '\0';
     if (w && w->host.logger)
         w->host.logger(w->host.componentEnvironment, w->name, status,
                        status >= fmi2Error ? "logStatusError" : "logStatusWarning", esc);
@@ -485,24 +480,3 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
     return r == fmi2Discard ? fmi2Discard : outcome(w, r, "fmi2GetRealStatus");
 }
 
-fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
-{
-    (void)s;
-    if (!c || !value) return fmi2Error;
-    return fmi2Discard;
-}
-
-fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
-{
-    (void)s;
-    if (!c || !value) return fmi2Error;
-    *value = fmi2False;
-    return fmi2Discard;
-}
-
-fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
-{
-    (void)s;
-    if (!c || !value) return fmi2Error;
-    return fmi2Discard;
-}

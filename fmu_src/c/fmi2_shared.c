@@ -1,0 +1,49 @@
+/*
+ * What the C FMU (fmi2_api.c) and the pythonfmu FMU's loader (loader.c) share: the
+ * formatting of log messages, and the FMI 2.0 status queries that neither supports (no
+ * asynchronous doStep, so no pending status to report: they check their arguments and
+ * answer fmi2Discard; fmi2GetStatus and fmi2GetRealStatus, which do answer, are in
+ * those files).
+ */
+#include <stdio.h>
+
+#include "fmi2_shared.h"
+
+void format_log_message(char *out, size_t size, const char *fmt, va_list ap)
+{
+    char buf[1200];
+    size_t j = 0;
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    for (size_t i = 0; buf[i] && j + 2 < size; ++i) {
+        if (buf[i] == '%') out[j++] = '%';
+        out[j++] = buf[i];
+    }
+    out[j] = '\0';
+}
+
+const char *log_category(fmi2Status status)
+{
+    return status == fmi2Warning ? "logStatusWarning" : status >= fmi2Error ? "logStatusError" : "logAll";
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
+{
+    (void)s;
+    if (!c || !value) return fmi2Error;
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
+{
+    (void)s;
+    if (!c || !value) return fmi2Error;
+    *value = fmi2False;
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
+{
+    (void)s;
+    if (!c || !value) return fmi2Error;
+    return fmi2Discard;
+}
