@@ -340,3 +340,13 @@ def test_bad_report_arguments_are_one_line_and_exit_2(tmp_path):
 
 def test_every_notebook_has_its_spec():
     assert sorted(SPECS) == sorted(p.stem for p in (ROOT / "notebooks").glob("*.ipynb"))
+
+
+def test_markdown_cells_have_no_stray_emphasis():
+    """A lone ``*`` between two word characters (``lbf*in``) turns the text that follows into
+    italics in both documents; units are written with a middle dot in prose."""
+    for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        for cell in nbformat.read(path, as_version=4).cells:
+            if cell.cell_type == "markdown":
+                text = cell.source.replace("**", "")
+                assert not re.search(r"\w\*\w", text), (path.name, cell.id, text)
