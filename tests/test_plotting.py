@@ -58,3 +58,37 @@ def test_every_axis_names_its_unit(name):
         for label in (ax.get_xlabel(), ax.get_ylabel()):
             if label and ax.get_label() != "<colorbar>":
                 assert "[" in label and "]" in label, (name, label)
+
+
+def _text_boxes(fig):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    return [(t.get_text(), Text.get_window_extent(t, renderer)) for t in fig.findobj(Text)   # text only, no arrow
+            if t.get_visible() and t.get_text().strip()]
+
+
+CROWDED = {
+    "time, 16 series with peaks (Figure 5-2)": lambda: plotting.fig_time(
+        [(f"run {k}" + (" (as published)" if k >= 8 else ""), np.linspace(0, 3, 61),
+          np.sin(np.linspace(0, 3, 61) + 0.01 * k) * (1 + 0.001 * k), {}) for k in range(16)],
+        "y6 [in]", "x", xlim=(0, 3), annotate_peaks=True),
+    "time, close horizontal lines (Figure 5-3)": lambda: plotting.fig_time(
+        [("a", np.linspace(5, 10, 11), np.full(11, 0.46), {})], "y6 [in]", "x",
+        hlines=[(f"run {k}: {v:.3f}", v) for k, v in enumerate([0.341, 0.461, 0.466, 0.927, 0.969, 1.268, 1.436])]),
+    "bars, 22 categories across (Figure 5-20)": lambda: plotting.fig_bars(
+        [f"study {k // 5}: case {k}" for k in range(22)],
+        [("corrected", np.linspace(-60, 60, 22)), ("thesis loads", np.linspace(50, -90, 22))],
+        "change [%]", "x", height=6.4, horizontal=True),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CROWDED))
+def test_crowded_figures_keep_their_text_apart(name):
+    """No two pieces of text on a crowded figure overlap (peak values, line labels, bar values)."""
+    boxes = _text_boxes(CROWDED[name]())
+    clashes = [(a, b) for i, (a, ba) in enumerate(boxes) for b, bb in boxes[i + 1:]
+               if ba.overlaps(bb) and min(ba.width, bb.width) > 0 and
+               min(ba.x1, bb.x1) - max(ba.x0, bb.x0) > 1 and min(ba.y1, bb.y1) - max(ba.y0, bb.y0) > 1]
+    assert not clashes, clashes[:5]

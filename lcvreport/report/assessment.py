@@ -162,7 +162,8 @@ class Assessment:
         return plotting.fig_bars([f"{s.axle} ({s.unit})" for s in rows],
                                  [("per kN of P", np.array([1e3 * s.offtracking_per_P_m_per_kN for s in rows])),
                                   ("per kN·m of T", np.array([1e3 * s.offtracking_per_T_m_per_kNm for s in rows]))],
-                                 "trimmed offtracking [mm]", f"Conicity sensitivity of {self.at}, ranked")
+                                 "trimmed offtracking [mm]", f"Conicity sensitivity of {self.at}, ranked",
+                                 height=1.2 + 0.32 * len(rows), horizontal=True)
 
     # ------------------------------------------------------------------ FMU
     def interface_rows(self) -> list[dict]:

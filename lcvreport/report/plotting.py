@@ -396,30 +396,64 @@ def fig_damping_over_speed(speeds_kph: np.ndarray, zeta: np.ndarray, max_real: n
 def fig_time(series: list[tuple[str, np.ndarray, np.ndarray, dict]], ylabel: str, title: str,
              hlines: list[tuple[str, float]] = (), xlim: tuple | None = None, annotate_peaks: bool = False,
              height: float = 3.4) -> Figure:
-    """Time histories: ``series`` of (label, time [s], values, line style keywords)."""
-    fig, ax = new_figure(PAGE_WIDTH_IN, height)
+    """Time histories: ``series`` of (label, time [s], values, line style keywords).
+
+    ``annotate_peaks`` marks each series' largest magnitude (within ``xlim``) with a dot and
+    gives its value in the legend; ``hlines`` are (label, value) dotted lines, one labelled
+    on the plot, several labelled in the right margin at their heights, spread apart
+    where they would overlap.  More than eight series put the legend below the plot."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, height + (0.9 if len(series) > 8 else 0.0))
     for i, (label, t, y, style) in enumerate(series):
         kw = {"color": PALETTE[i % len(PALETTE)], "lw": 1.1}
         kw.update(style)
-        ax.plot(t, y, label=label, **kw)
         if annotate_peaks:
             mask = np.ones_like(t, dtype=bool) if xlim is None else (t >= xlim[0]) & (t <= xlim[1])
             k = int(np.argmax(np.abs(np.where(mask, y, 0))))
-            ax.annotate(f"{y[k]:.3f}", (t[k], y[k]), fontsize=SMALL_PT, color=kw["color"], xytext=(2, 2),
-                        textcoords="offset points")
+            label = f"{label} (peak {y[k]:.3f})"
+            ax.plot(t[k], y[k], "o", ms=3, color=kw["color"])
+        ax.plot(t, y, label=label, **kw)
     for label, value in hlines:
         ax.axhline(value, color="black", ls=":", lw=1)
-        ax.annotate(label, (1.0, value), xycoords=("axes fraction", "data"), ha="right", va="bottom",
-                    fontsize=SMALL_PT)
+    if len(hlines) == 1:
+        ax.annotate(hlines[0][0], (1.0, hlines[0][1]), xycoords=("axes fraction", "data"), ha="right",
+                    va="bottom", fontsize=SMALL_PT)
     if xlim is not None:
         ax.set_xlim(*xlim)
+    if len(hlines) > 1:
+        _margin_labels(ax, hlines)
     ax.set_xlabel("time [s]")
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3)
-    if series:
+    if len(series) > 8:
+        ax.legend(fontsize=SMALL_PT, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
+    elif series:
         ax.legend(fontsize=SMALL_PT, ncol=2)
     ax.set_title(title, fontsize=9)
     return fig
+
+
+def _margin_labels(ax, lines: list[tuple[str, float]]) -> None:
+    """Label horizontal lines in the right margin, each at its height unless that would put
+    it within one text line of its neighbour: then the labels are spread evenly apart
+    (keeping their order) and a leader joins each to its line."""
+    lo, hi = ax.get_ylim()
+    height_pt = ax.figure.get_size_inches()[1] * 72 * 0.75          # about the axes' height [pt]
+    gap = (SMALL_PT * 1.35) * (hi - lo) / height_pt                     # one text line in data units
+    order = sorted(range(len(lines)), key=lambda k: lines[k][1])
+    placed = [lines[k][1] for k in order]
+    for _ in range(len(placed)):                                        # push up, then pull the block down
+        for j in range(1, len(placed)):
+            placed[j] = max(placed[j], placed[j - 1] + gap)
+        excess = placed[-1] - max(hi - gap / 2, lines[order[-1]][1])
+        if excess <= 0:
+            break
+        placed = [p - excess for p in placed]
+    for k, y in zip(order, placed):
+        label, value = lines[k]
+        ax.annotate(label, (1.0, value), xycoords=("axes fraction", "data"), xytext=(1.03, y),
+                    textcoords=("axes fraction", "data"), ha="left", va="center", fontsize=SMALL_PT,
+                    annotation_clip=False, arrowprops=dict(arrowstyle="-", lw=0.4, color="0.4",
+                                                           shrinkA=0, shrinkB=1))
 
 
 def plot_time_response(response, signals=None, ax=None, **style) -> Figure:
@@ -482,21 +516,41 @@ def fig_frequency(f_hz: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel
 
 
 def fig_bars(labels: list[str], groups: list[tuple[str, np.ndarray]], ylabel: str, title: str,
-             height: float = 3.6) -> Figure:
-    """Grouped bar chart (Figures 5-4, 5-8, 5-13, 5-18, 5-20; conicity sensitivity)."""
+             height: float = 3.6, horizontal: bool = False) -> Figure:
+    """Grouped bar chart (Figures 5-4, 5-8, 5-13, 5-18, 5-20; conicity sensitivity).
+
+    ``horizontal=True`` lays the categories down the page, one row each, top to bottom in the
+    order given, for many categories with long names (Figure 5-20): every value label then
+    has a row of its own; ``ylabel`` names the value axis either way."""
     fig, ax = new_figure(PAGE_WIDTH_IN, height)
     x = np.arange(len(labels))
     w = 0.8 / len(groups)
     for i, (glabel, values) in enumerate(groups):
-        bars = ax.bar(x + (i - (len(groups) - 1) / 2) * w, values, w, label=glabel, color=PALETTE[i])
-        for b, v in zip(bars, values):
-            ax.annotate(f"{v:.3g}", (b.get_x() + b.get_width() / 2, b.get_height()), ha="center",
-                        va="bottom" if v >= 0 else "top", fontsize=SMALL_PT)
-    ax.set_xticks(x, labels, rotation=25, ha="right", fontsize=SMALL_PT)
-    ax.axhline(0, color="black", lw=0.6)
-    ax.set_ylabel(ylabel)
+        pos = x + (i - (len(groups) - 1) / 2) * w
+        if horizontal:
+            bars = ax.barh(pos, values, w, label=glabel, color=PALETTE[i])
+            for b, v in zip(bars, values):
+                ax.annotate(f" {v:.3g} ", (b.get_width(), b.get_y() + b.get_height() / 2), va="center",
+                            ha="left" if v >= 0 else "right", fontsize=SMALL_PT)
+        else:
+            bars = ax.bar(pos, values, w, label=glabel, color=PALETTE[i])
+            for b, v in zip(bars, values):
+                ax.annotate(f"{v:.3g}", (b.get_x() + b.get_width() / 2, b.get_height()), ha="center",
+                            va="bottom" if v >= 0 else "top", fontsize=SMALL_PT)
+    if horizontal:
+        ax.set_yticks(x, labels, fontsize=SMALL_PT)
+        ax.set_ylim(len(labels) - 0.5, -0.5)
+        lo, hi = ax.get_xlim()
+        ax.set_xlim(lo - 0.12 * (hi - lo), hi + 0.12 * (hi - lo))     # room for the value labels
+        ax.axvline(0, color="black", lw=0.6)
+        ax.set_xlabel(ylabel)
+        ax.grid(True, axis="x", lw=0.3)
+    else:
+        ax.set_xticks(x, labels, rotation=25, ha="right", fontsize=SMALL_PT)
+        ax.axhline(0, color="black", lw=0.6)
+        ax.set_ylabel(ylabel)
+        ax.grid(True, axis="y", lw=0.3)
     ax.legend(fontsize=SMALL_PT)
-    ax.grid(True, axis="y", lw=0.3)
     ax.set_title(title, fontsize=9)
     return fig
 
