@@ -13,6 +13,10 @@
  *       G / P / F          fmi2GetFMUstate / fmi2SetFMUstate / fmi2FreeFMUstate of one slot
  *       B                  serialize the slot, then deserialize the bytes into the slot
  *       N <offset>         serialize the slot, write a NaN at byte <offset>, deserialize
+ *       K <offset> <int>   serialize the slot, write the int at byte <offset>, deserialize
+ *       L <n>              <n> times fmi2GetFMUstate into the same slot
+ *       t                  fmi2Terminate
+ *       D <0|1>            fmi2SetDebugLogging(on/off, no categories)
  *       Z <n>              deserialize <n> bytes of garbage (0: empty)
  *       0                  deserialize from a NULL buffer
  *       c <n>              <n> cycles of instantiate, initialize, 10 steps, free
@@ -22,6 +26,9 @@
  *       n steps of h with input vr_in = 1000; prints "us_per_step <x>" and output vr_out.
  *
  * DIR is the unzipped FMU; the library is DIR/binaries/linux64/IDENTIFIER.so.
+ * Environment: LCV_HOST_URI replaces the resource location (file://DIR/resources; "NULL" for
+ * a null pointer), LCV_HOST_NAME the instance name ("NULL" likewise), LCV_HOST_LOGGING=0
+ * instantiates with loggingOn = false.
  * Build: gcc -std=c99 -O2 -o c_host c_host.c -ldl
  */
 #define _POSIX_C_SOURCE 200809L
@@ -108,6 +115,10 @@ int main(int argc, char **argv)
     char path[4096], uri[4096];
     snprintf(path, sizeof path, "%s/binaries/linux64/%s.so", dir, id);
     snprintf(uri, sizeof uri, "file://%s/resources", dir);
+    const char *uri_arg = uri, *name_arg = "host";
+    if (getenv("LCV_HOST_URI")) uri_arg = strcmp(getenv("LCV_HOST_URI"), "NULL") == 0 ? NULL : getenv("LCV_HOST_URI");
+    if (getenv("LCV_HOST_NAME")) name_arg = strcmp(getenv("LCV_HOST_NAME"), "NULL") == 0 ? NULL : getenv("LCV_HOST_NAME");
+    int logging = !(getenv("LCV_HOST_LOGGING") && strcmp(getenv("LCV_HOST_LOGGING"), "0") == 0);
     void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!lib) { fprintf(stderr, "dlopen failed: %s\n", dlerror()); return 3; }
 
@@ -125,12 +136,14 @@ int main(int argc, char **argv)
     GetState_t getState = (GetState_t)sym(lib, "fmi2GetFMUstate");
     SetState_t setState = (SetState_t)sym(lib, "fmi2SetFMUstate");
     GetState_t freeState = (GetState_t)sym(lib, "fmi2FreeFMUstate");
+    typedef fmi2Status (*Debug_t)(fmi2Component, fmi2Boolean, size_t, const fmi2String *);
+    Debug_t debugLogging = (Debug_t)sym(lib, "fmi2SetDebugLogging");
     StateSize_t stateSize = (StateSize_t)sym(lib, "fmi2SerializedFMUstateSize");
     Serialize_t serialize = (Serialize_t)sym(lib, "fmi2SerializeFMUstate");
     Deserialize_t deserialize = (Deserialize_t)sym(lib, "fmi2DeSerializeFMUstate");
 
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
-    fmi2Component c = instantiate("host", 1 /* fmi2CoSimulation */, guid, uri, &cb, 0, 1);
+    fmi2Component c = instantiate(name_arg, 1 /* fmi2CoSimulation */, guid, uri_arg, &cb, 0, logging);
     if (!c) { printf("instantiate failed\n"); fflush(stdout); return 4; }
     setup(c, 0, 0.0, 0.0, 0, 0.0);
     enter(c);
@@ -194,16 +207,28 @@ int main(int argc, char **argv)
                 printf("status %d\n", setState(c, slot));
             } else if (cmd == 'F') {
                 printf("status %d\n", freeState(c, &slot));
-            } else if (cmd == 'B' || cmd == 'N') {
+            } else if (cmd == 't') {
+                printf("status %d\n", terminate(c));
+            } else if (cmd == 'D') {
+                printf("status %d\n", debugLogging(c, atoi(p) != 0, 0, NULL));
+            } else if (cmd == 'L') {
+                long n = atol(p);
+                fmi2Status st = 0;
+                for (long k = 0; k < n && st == 0; ++k) st = getState(c, &slot);
+                printf("status %d\n", st);
+            } else if (cmd == 'B' || cmd == 'N' || cmd == 'K') {
                 size_t size = 0;
-                int offset = cmd == 'N' ? atoi(p) : -1;
+                int offset = -1, number = 0;
+                if (cmd != 'B' && sscanf(p, "%d %d", &offset, &number) < 1) continue;
                 if (stateSize(c, slot, &size) != 0 || size == 0) { printf("status 3\n"); continue; }
                 fmi2Byte *buf = (fmi2Byte *)malloc(size);
                 fmi2Status st = serialize(c, slot, buf, size);
-                if (offset >= 0 && (size_t)offset + sizeof(double) <= size) {
+                if (cmd == 'N' && offset >= 0 && (size_t)offset + sizeof(double) <= size) {
                     double nan = NAN;
                     memcpy(buf + offset, &nan, sizeof nan);
                 }
+                if (cmd == 'K' && offset >= 0 && (size_t)offset + sizeof(int) <= size)
+                    memcpy(buf + offset, &number, sizeof number);
                 if (st == 0) st = deserialize(c, buf, size, &slot);
                 printf("status %d\n", st);
                 free(buf);

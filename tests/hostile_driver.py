@@ -101,11 +101,11 @@ def main(path: str, case: str) -> None:
             step(s)
             state = s.fmu.getFMUState()
             data = bytearray(s.fmu.serializeFMUState(state))
-            if data.startswith(b"lcv-fmu-state/1"):     # pythonfmu FMU: JSON after a magic line
-                head, body = bytes(data).split(b"\n", 1)
+            if data.startswith(b"lcv-fmu-state/1"):     # pythonfmu FMU: JSON after a magic line, phase byte
+                head, body = bytes(data[:-1]).split(b"\n", 1)
                 doc = json.loads(body)
                 doc["engine"]["z"][0] = float("nan")
-                data = bytearray(head + b"\n" + json.dumps(doc).encode())
+                data = bytearray(head + b"\n" + json.dumps(doc).encode() + bytes(data[-1:]))
             else:                                      # C FMU: z[0] of the snapshot set to NaN
                 offset = 4 + 4 + 64 + 64 + 16 + 8 * len(s.itf.inputs)   # magic, size, guid, preset, params, w
                 data[offset:offset + 8] = bytes(bytearray(ctypes.c_double(float("nan"))))

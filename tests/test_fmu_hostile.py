@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from fmu_support import host_statuses, host_values, run_host, unzip
+from fmu_support import host_env, host_statuses, host_values, run_host, unzip
 
 HERE = Path(__file__).resolve().parent
 ERROR = 3
@@ -154,3 +154,169 @@ def test_memory_per_instantiate_free_cycle(c_host, unzipped_fmus, identifier, li
     rss = [int(x) for x in re.findall(r"rss_kb (\d+)", p.stdout)]
     per_cycle = (rss[1] - rss[0]) / 2000
     assert p.returncode == 0 and per_cycle <= limit_kb, (per_cycle, p.stdout[-500:])
+
+
+# ---------------------------------------------------------------------------- round three (issue 22)
+@pytest.mark.parametrize("identifier", ["LCV", "LCVNative"])
+@pytest.mark.parametrize("script, expected", [
+    ("S {preset} nonsense\ni\n", [0, 3]),                 # a bad parameter at ExitInitializationMode
+    ("i\ns {tire_scale} 2\n", [0, 3]),                    # a fixed parameter after initialization
+    ("i\ni\n", [0, 3]),                                   # ExitInitializationMode twice
+    ("i\nd 0 0.01\nt\nd 0.01 0.01\ns {u} 10\ni\n", [0, 0, 0, 3, 3, 3]),   # calls after fmi2Terminate
+    ("D 0\nS {preset} nonsense\ni\nD 1\nd 0 0.01\n", [0, 0, 3, 0, 3]),  # fmi2SetDebugLogging off, then on
+], ids=["bad_parameter", "fixed_after_init", "exit_init_twice", "after_terminate", "debug_logging_toggled"])
+@pytest.mark.parametrize("logging", ["1", "0"])
+def test_statuses_do_not_depend_on_the_logging_flag(c_host, unzipped_fmus, identifier, script, expected, logging):
+    """With loggingOn false (fmpy's default) every refused call is still fmi2Error, and its
+    error message still reaches the host, as the C FMU has always done."""
+    d, _guid, vr = unzipped = unzipped_fmus[identifier]
+    if "{preset}" in script and "preset" not in vr:
+        pytest.skip("vehicle FMUs have no preset")
+    env = {**host_env(), "LCV_HOST_LOGGING": logging}
+    p = run_host(c_host, unzipped, identifier, script.format(**vr), env=env)
+    assert p.returncode == 0 and p.stdout.rstrip().endswith("done"), (p.stdout[-2000:], p.stderr[-2000:])
+    assert host_statuses(p.stdout) == expected, p.stdout
+    assert any(line.startswith("log 3") for line in p.stdout.splitlines()), p.stdout
+
+
+@pytest.mark.parametrize("identifier", ["LCV", "LCVNative"])
+def test_a_percent_sign_in_a_logged_value_does_not_reach_printf_as_a_format(c_host, unzipped_fmus, identifier):
+    """The host formats the message (FMIL and this host use vsnprintf): '%s%s%n' from a
+    preset string must come back as text, not be read as conversions."""
+    d, _guid, vr = unzipped = unzipped_fmus[identifier]
+    p = run_host(c_host, unzipped, identifier, f"S {vr['preset']} %s%s%s%n%s\ni\n")
+    assert p.returncode == 0 and p.stdout.rstrip().endswith("done"), (p.returncode, p.stdout[-2000:], p.stderr[-2000:])
+    assert host_statuses(p.stdout) == [0, 3]
+    assert any("unknown preset '%s%s%s%n%s'" in line for line in p.stdout.splitlines()), p.stdout
+
+
+@pytest.mark.parametrize("identifier", ["LCV", "LCVNative"])
+def test_getting_the_fmu_state_into_the_same_slot_does_not_grow_memory(c_host, unzipped_fmus, identifier):
+    """FMI 2: a non-NULL slot is updated, not leaked (1.5 kB per call before)."""
+    p = run_host(c_host, unzipped_fmus[identifier], identifier, "i\nd 0 0.01\nL 500\nm\nL 5000\nm\n", timeout=600)
+    rss = [int(x) for x in re.findall(r"rss_kb (\d+)", p.stdout)]
+    assert p.returncode == 0 and host_statuses(p.stdout) == [0, 0, 0, 0], p.stdout[-2000:]
+    assert (rss[1] - rss[0]) / 5000 < 0.05, rss
+
+
+def test_a_crafted_state_stepping_without_a_vehicle_is_refused_by_the_c_fmu(c_host, unzipped_fmus):
+    """Phase 'step complete' with no vehicle built (taken before initialization, phase
+    field rewritten) used to pass the checks and segfault the next doStep."""
+    unzipped = unzipped_fmus["LCVNative"]
+    n_inputs, max_m = 18, 14                          # the preset FMU: 18 inputs, 12 states + psi1, Y1
+    phase_offset = 4 + 4 + 64 + 64 + 16 + 8 * n_inputs + 8 * max_m + 16 + 4   # see fmi2_api.c, model.h
+    p = run_host(c_host, unzipped, "LCVNative", f"G\nK {phase_offset} 4\nP\nd 0 0.01\nF\n")
+    assert p.returncode == 0 and p.stdout.rstrip().endswith("done"), (p.stdout[-2000:], p.stderr[-2000:])
+    assert host_statuses(p.stdout) == [0, 3, 0, 3, 0], p.stdout
+    assert "was not written by this FMU" in p.stdout
+
+
+def _run_located(c_host, unzipped, identifier, uri=None, name=None, extra_env=None, script="i\nd 0 0.01\n"):
+    env = {**host_env(), **(extra_env or {})}
+    if uri is not None:
+        env["LCV_HOST_URI"] = uri
+    if name is not None:
+        env["LCV_HOST_NAME"] = name
+    return run_host(c_host, unzipped, identifier, script, env=env)
+
+
+@pytest.mark.parametrize("identifier", ["LCV", "LCVNative"])
+@pytest.mark.parametrize("form", ["file:///{d}/resources", "file:{d}/resources", "file://localhost{d}/resources",
+                                  "file://{d}/resources/", "FILE://{d}/resources"])
+def test_every_form_of_a_file_uri_works(c_host, unzipped_fmus, identifier, form):
+    d, _guid, _vr = unzipped = unzipped_fmus[identifier]
+    uri = form.format(d=str(d)).replace("///" + str(d), "//" + str(d))
+    p = _run_located(c_host, unzipped, identifier, uri=uri)
+    assert p.returncode == 0 and host_statuses(p.stdout) == [0, 0], (uri, p.stdout[-2000:], p.stderr[-2000:])
+
+
+@pytest.mark.parametrize("identifier", ["LCV"])
+@pytest.mark.parametrize("uri, fragment", [
+    ("NULL", "fmuResourceLocation is NULL"),
+    ("file:///nonexistent/folder", "does not exist"),
+    ("http://example.invalid/resources", "not a file: URI"),
+    ("file://otherhost/tmp", "another host"),
+    ("file:///tmp/%zz", "bad %-escape"),
+    ("file:///tmp/%ff%fe", "not UTF-8"),
+    ("relative/folder", "not a file: URI"),
+])
+def test_a_bad_resource_location_fails_instantiate_with_a_message(c_host, unzipped_fmus, identifier, uri, fragment):
+    """Not a SIGSEGV or SIGABRT inside pythonfmu: fmi2Instantiate returns NULL and says why."""
+    p = _run_located(c_host, unzipped_fmus[identifier], identifier, uri=uri)
+    assert p.returncode == 4 and "instantiate failed" in p.stdout, (p.returncode, p.stdout[-2000:], p.stderr[-2000:])
+    assert any(line.startswith("log 3") and fragment in line for line in p.stdout.splitlines()), p.stdout
+
+
+@pytest.mark.parametrize("identifier", ["LCV", "LCVNative"])
+@pytest.mark.parametrize("encoded", [True, False])
+def test_an_fmu_unzipped_under_a_non_ascii_folder_works(c_host, unzipped_fmus, tmp_path, identifier, encoded):
+    from urllib.parse import quote
+    d, guid, vr = unzipped_fmus[identifier]
+    target = tmp_path / "ü dir ñ"
+    shutil.copytree(d, target)
+    uri = "file://" + (quote(str(target)) if encoded else str(target)) + "/resources"
+    p = _run_located(c_host, (target, guid, vr), identifier, uri=uri)
+    assert p.returncode == 0 and host_statuses(p.stdout) == [0, 0], (uri, p.stdout[-2000:], p.stderr[-2000:])
+
+
+@pytest.mark.parametrize("identifier", ["LCV", "LCVNative"])
+def test_a_null_instance_name_works(c_host, unzipped_fmus, identifier):
+    p = _run_located(c_host, unzipped_fmus[identifier], identifier, name="NULL", script="S 999999 x\ni\nd 0 0.01\n")
+    assert p.returncode == 0 and p.stdout.rstrip().endswith("done"), (p.returncode, p.stdout[-2000:], p.stderr[-2000:])
+    assert host_statuses(p.stdout)[1:] == [0, 0]
+
+
+def _python_paths():
+    import sysconfig
+    import numpy
+    lib = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("INSTSONAME")
+    return str(lib), sys.base_prefix, str(Path(numpy.__file__).resolve().parents[1])
+
+
+def test_the_readme_recipe_for_another_machine_works_without_a_python_home(c_host, tmp_path):
+    """An FMU built elsewhere (its recorded libpython, home and site-packages do not exist
+    here), run as the README says: LCV_FMU_LIBPYTHON and LCV_FMU_SITE_PACKAGES set,
+    LCV_FMU_PYTHONHOME not (optional).  The home is found from the library; before, the
+    host exited in fmi2Instantiate ("Fatal Python error: init_fs_encoding")."""
+    from lcvreport.fmu.build import build_python_fmu
+    from lcvreport.fmu.interface import preset_interface
+    lib, _home, site = _python_paths()
+    elsewhere = {"libpython": "/elsewhere/lib/libpython3.11.so.1.0", "home": "/elsewhere",
+                 "site_packages": "/elsewhere/lib/python3.11/site-packages", "version": "3.11"}
+    fmu = build_python_fmu(preset_interface(), tmp_path / "built", "LCV", env=elsewhere)
+    unzipped = unzip(fmu, tmp_path / "LCV")
+    p = run_host(c_host, unzipped, "LCV", "i\nd 0 0.01\n")
+    assert p.returncode == 4 and "cannot load the Python library /elsewhere" in p.stdout, p.stdout[-2000:]
+    p = _run_located(c_host, unzipped, "LCV", extra_env={"LCV_FMU_LIBPYTHON": lib, "LCV_FMU_SITE_PACKAGES": site})
+    assert p.returncode == 0 and host_statuses(p.stdout) == [0, 0], (p.returncode, p.stdout[-2000:], p.stderr[-2000:])
+
+
+@pytest.mark.parametrize("variable, value, fragment", [
+    ("LCV_FMU_PYTHONHOME", "/nonexistent/python", "has no standard library"),
+    ("LCV_FMU_PYTHONHOME", "/tmp", "has no standard library"),
+    ("LCV_FMU_LIBPYTHON", "/nonexistent/libpython3.11.so", "cannot load the Python library"),
+    ("LCV_FMU_LIBPYTHON", "/lib/x86_64-linux-gnu/libm.so.6", "is not a Python library"),
+    ("LCV_FMU_SITE_PACKAGES", "/nonexistent/site-packages", "does not exist"),
+])
+def test_a_wrong_python_setting_fails_instantiate_with_a_message(c_host, unzipped_fmus, variable, value, fragment):
+    p = _run_located(c_host, unzipped_fmus["LCV"], "LCV", extra_env={variable: value})
+    assert p.returncode == 4 and "instantiate failed" in p.stdout, (p.returncode, p.stdout[-2000:], p.stderr[-2000:])
+    assert any(line.startswith("log 3") and fragment in line for line in p.stdout.splitlines()), p.stdout
+
+
+def test_the_hosts_own_pythonhome_does_not_reach_the_fmus_interpreter(c_host, unzipped_fmus):
+    """The interpreter the FMU starts is isolated: a PYTHONHOME meant for something else
+    in the host's environment neither breaks it nor changes it."""
+    p = _run_located(c_host, unzipped_fmus["LCV"], "LCV", extra_env={"PYTHONHOME": "/nonexistent",
+                                                                      "PYTHONPATH": "/nonexistent"})
+    assert p.returncode == 0 and host_statuses(p.stdout) == [0, 0], (p.returncode, p.stdout[-2000:], p.stderr[-2000:])
+
+
+def test_a_site_packages_path_is_never_run_as_code(c_host, unzipped_fmus, tmp_path):
+    evil = tmp_path / "x''');import os;os._exit(7);r'''"     # pasted into r'''...''' it would exit the host
+    evil.mkdir()
+    p = _run_located(c_host, unzipped_fmus["LCV"], "LCV", extra_env={"LCV_FMU_SITE_PACKAGES": str(evil)})
+    # numpy may or may not be importable without the venv's site-packages (it is when the
+    # base Python has one); either way the host lives on
+    assert p.returncode in (0, 4) and p.stdout.rstrip().endswith(("done", "instantiate failed")), \
+        (p.returncode, p.stdout[-2000:], p.stderr[-2000:])

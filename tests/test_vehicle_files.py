@@ -216,10 +216,26 @@ def test_example_files_are_what_their_script_writes(name):
     assert "# " in text.splitlines()[0]          # where the numbers come from, first line
     built = {"western_double": make_examples.western_double}.get(name)
     if built is not None:
-        assert built() == v
+        made = built()
     else:
         spec = {"b_double": make_examples.B_DOUBLE, "truck_full_trailer": make_examples.TRUCK_FULL_TRAILER}[name]
-        assert make_examples.chain(name, v.description, spec) == v
+        made = make_examples.chain(name, v.description, spec)
+    # the tire coefficients come from least-squares fits (LAPACK): their last digits depend on
+    # the BLAS kernel of the machine (3 ulp seen between two x86-64 kernels), so numbers are
+    # compared to 1e-13 relative and everything else exactly
+    a, b = _flat(made), _flat(v)
+    numbers = [i for i, x in enumerate(b) if isinstance(x, float)]
+    assert [x for i, x in enumerate(a) if i not in numbers] == [x for i, x in enumerate(b) if i not in numbers]
+    assert [a[i] for i in numbers] == pytest.approx([b[i] for i in numbers], rel=1e-13, abs=0.0)
+
+
+def _flat(vehicle) -> list:
+    out = [vehicle.name, vehicle.description]
+    for unit in vehicle.units:
+        out += [getattr(unit, f) for f in unit.__dataclass_fields__ if f != "axles"]
+        for axle in unit.axles:
+            out += [getattr(axle, f) for f in axle.__dataclass_fields__]
+    return out
 
 
 def test_example_vehicles_are_what_they_say(example):

@@ -452,7 +452,12 @@ int model_check_state(ModelInstance *c, const ModelState *s)
         return -1;
     }
     int phases = PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError;
-    if (!(s->phase & phases) || (s->phase & ~phases) || s->vehicle < -1 || s->vehicle >= LCV_N_VEHICLES) {
+    /* one phase; a vehicle exactly when initialization has built one (StepComplete and
+       Terminated need it, Instantiated and InitializationMode have none) */
+    int needs_vehicle = s->phase == PhaseStepComplete || s->phase == PhaseTerminated;
+    int has_none = s->phase == PhaseInstantiated || s->phase == PhaseInitializationMode;
+    if (!(s->phase & phases) || (s->phase & (s->phase - 1)) || s->vehicle < -1 || s->vehicle >= LCV_N_VEHICLES ||
+        (needs_vehicle && s->vehicle < 0) || (has_none && s->vehicle >= 0)) {
         snprintf(c->msg, sizeof c->msg, "the FMU state is refused: it was not written by this FMU");
         return -1;
     }

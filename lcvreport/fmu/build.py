@@ -351,7 +351,9 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
                                                           generation_tool="lcvreport.fmu.build (pythonfmu 0.7.0)")
         (tmp / "loader_config.h").write_text(loader_config_header(itf, model_identifier, fmu_guid, env), "utf-8")
         loader = tmp / f"{model_identifier}.so"
-        _compile([src / "c" / "loader.c", src / "c" / "fmi2_shared.c"], [tmp, src / "c", fmi_header_dir()], loader,
+        # Python.h for the types of the initialization API only (the loader links no libpython)
+        _compile([src / "c" / "loader.c", src / "c" / "fmi2_shared.c"],
+                 [tmp, src / "c", fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
                  ["-ldl", "-lpthread"])
         files[f"binaries/linux64/{model_identifier}.so"] = loader.read_bytes()
         files[f"binaries/linux64/{EXPORT_LIB}"] = export
