@@ -18,6 +18,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``presets``          the six thesis vehicles, shipped as vehicle files
     ``builder``          M, S and the input matrices of any chain (SI or thesis units)
     ``loads``            residual loads P, T; the 1 % rule; load conventions
+    ``plausibility``     warnings for legal but implausible numbers (unit typos)
 ``analysis/``            **linear analysis** (numpy, scipy):
     ``modes``            eigenvalues, damping, mode shapes
     ``steady``           steady state -S^-1 F

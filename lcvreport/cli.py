@@ -40,6 +40,8 @@ from .units import MPS_PER_KPH, MPS_PER_MPH, THESIS, SI, mps_to_kph
 
 #: exit status of a closed pipe (128 + SIGPIPE), as a shell reports a tool SIGPIPE ended
 EXIT_BROKEN_PIPE = 141
+#: exit status after Ctrl-C (128 + SIGINT), as a shell reports it
+EXIT_INTERRUPTED = 130
 
 
 class UsageError(Exception):
@@ -77,7 +79,10 @@ def _ranged(key: str, factor: float = 1.0, unit: str | None = None, what: str = 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``lcv``."""
     from .model.presets import MASS_OPTIONS, PRESETS
+    from importlib.metadata import version
+    __version__ = version("lcvreport")
     p = _Parser(prog="lcv", description="Linear yaw-plane model of long combination vehicles.")
+    p.add_argument("--version", action="version", version=f"lcv (lcvreport) {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
@@ -148,6 +153,7 @@ def build_parser() -> argparse.ArgumentParser:
     load(rep, False, convention=False)
     rep.add_argument("--out", required=True, metavar="DIR", help="output folder")
     rep.add_argument("--no-pdf", action="store_true", help="HTML only")
+    rep.add_argument("--paper", default="letter", choices=("letter", "a4"), help="paper of the PDF (default letter)")
     sub.add_parser("presets", help="list the presets").add_argument("--json", action="store_true")
     return p
 
@@ -197,9 +203,13 @@ def _vehicle(args: argparse.Namespace):
     if getattr(args, "masses", "table") != "table":
         raise UsageError("argument --masses: only presets have unrounded masses")
     try:
-        return load_vehicle(args.vehicle)
+        v = load_vehicle(args.vehicle)
     except VehicleError as exc:
         raise UsageError(f"argument --vehicle {args.vehicle}: {exc}") from None
+    from .model.plausibility import plausibility_warnings
+    for line in plausibility_warnings(v):
+        print(f"lcv: warning: {args.vehicle}: {line}", file=sys.stderr)
+    return v
 
 
 def _speed_mps(args: argparse.Namespace) -> float:
@@ -399,7 +409,11 @@ def _cmd_fmu(args, out: _Out) -> int:
 
 
 def _cmd_report(args, out: _Out) -> int:
-    from .report.build import ReportError, build_assessment
+    from .report.build import OutputFolderError, ReportError, build_assessment, check_output_folder
+    try:
+        check_output_folder(args.out)          # before anything is computed
+    except OutputFolderError as exc:
+        raise UsageError(f"argument {exc}") from None
     v = _vehicle(args)
     speed = _speed_mps(args) if (args.speed_kph is not None or args.speed_mph is not None) else None
     units = _load_units(args, v) if args.load is not None else None
@@ -409,11 +423,17 @@ def _cmd_report(args, out: _Out) -> int:
             one_percent_rule(v, units)
         except ValueError as exc:
             raise UsageError(f"argument --load: {exc}") from None
+    text = None
+    if args.vehicle is not None:               # the user's file as written, comments and all
+        from .model.vehicle_file import read_vehicle_text
+        text = read_vehicle_text(args.vehicle)
     t0 = time.perf_counter()
     try:
         res = build_assessment(v, args.out, speed_mps=speed, load_units=units, pdf=not args.no_pdf,
                                progress=lambda text: print(f"lcv report: {text}", file=sys.stderr, flush=True),
-                               source=args.vehicle or f"preset {args.preset}")
+                               source=args.vehicle or f"preset {args.preset}", vehicle_text=text, paper=args.paper)
+    except OutputFolderError as exc:
+        raise UsageError(f"argument {exc}") from None
     except ReportError as exc:
         raise OutputError(str(exc)) from None
     for key in ("html", "pdf", "data"):
@@ -436,6 +456,9 @@ def run(argv: Sequence[str] | None = None, out=None) -> int:
         status = COMMANDS[args.command](args, writer)
         stream.flush()
         return status
+    except KeyboardInterrupt:
+        print("lcv: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except UsageError as exc:
         print(f"lcv: error: {exc}", file=sys.stderr)
         return 2

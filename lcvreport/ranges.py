@@ -158,6 +158,7 @@ VEHICLE: dict[str, Range] = {
     "longitudinal_stiffness_N": Range("longitudinal_stiffness_N", "N", 0.0, 1e7, description="C_S per tire"),
     "dual_spacing_m": Range("dual_spacing_m", "m", 0.0, 2.0, description="D of a dual set"),
     "static_load_N": Range("static_load_N", "N", 0.0, 1e7, description="static vertical axle load"),
+    "units": Range("units", "1", 1.0, 50.0, description="units in one vehicle (a road train has a few dozen at most)"),
 }
 
 

@@ -271,3 +271,104 @@ def test_simulate_streams_its_first_row_at_once_in_constant_memory():
 
 def test_ranges_table_is_what_the_cli_enforces():
     assert RANGES["speed"].high == 70.0 and RANGES["output_rows"].high == 1e7
+
+
+# ---------------------------------------------------------------------------- round three (issue 22)
+def _variant(tmp_path, name, edit):
+    text = edit(open(WESTERN).read())
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def test_a_vehicle_without_a_steered_axle_has_its_steer_measures_null_with_the_reason(tmp_path):
+    path = _variant(tmp_path, "nosteer", lambda t: t.replace("steered = true\n", ""))
+    p = lcv_process("measures", "--vehicle", path, "--speed-kph", "88", "--load", "trailer2", "--json")
+    assert p.returncode == 0, p.stderr
+    doc = json.loads(p.stdout)
+    assert doc["ra_frequency"] is None and doc["ra_single_sine"] is None and doc["trim"] is None
+    assert doc["ay_gain_per_unit"] is None and 0 < doc["least_damping_ratio"] < 1
+    p = lcv_process("measures", "--vehicle", path, "--speed-kph", "88")
+    assert p.returncode == 0 and "no steered axle" in p.stdout
+
+
+@pytest.mark.parametrize("name, edit, fragment", [
+    ("kn_per_rad", lambda t: __import__("re").sub(r"cornering_stiffness_N_per_rad = [0-9.e+]+",
+                                                   "cornering_stiffness_N_per_rad = 125.0", t), "kN/rad"),
+    ("tonnes", lambda t: __import__("re").sub(r"mass_kg = [0-9.e+]+", "mass_kg = 33.0", t), "tonnes"),
+])
+def test_unit_typos_give_plausibility_warnings_on_stderr(tmp_path, name, edit, fragment):
+    path = _variant(tmp_path, name, edit)
+    p = lcv_process("eig", "--vehicle", path, "--speed-kph", "88", "--json")
+    warnings = [line for line in p.stderr.splitlines() if line.startswith("lcv: warning:")]
+    assert warnings and all(fragment in w for w in warnings[:1]), p.stderr
+    json.loads(p.stdout)                                    # the result still comes, on stdout
+
+
+def test_no_warnings_for_the_shipped_vehicles():
+    from lcvreport.model.plausibility import plausibility_warnings
+    for v in [load_preset(p) for p in PRESETS] + [load_vehicle(EXAMPLES / f"{n}.toml") for n in EXAMPLE_NAMES]:
+        assert plausibility_warnings(v) == [], v.name
+
+
+def test_a_trim_steer_outside_the_ranges_table_is_refused(tmp_path):
+    path = _variant(tmp_path, "kn", lambda t: __import__("re").sub(
+        r"cornering_stiffness_N_per_rad = [0-9.e+]+", "cornering_stiffness_N_per_rad = 125.0", t))
+    p = lcv_process("measures", "--vehicle", path, "--speed-kph", "88", "--load", "trailer2", "--json")
+    assert p.returncode == 2 and p.stdout == "" and "trim steer angle" in p.stderr and "[-1, 1] rad" in p.stderr
+    assert "Traceback" not in p.stderr
+
+
+@pytest.mark.parametrize("name, make, fragment", [
+    ("dotted", lambda t: "a" + ".b" * 40000 + " = 1\n" + t, "dotted parts"),
+    ("nested", lambda t: "x = " + "[" * 5000 + "]" * 5000 + "\n" + t, "nests too deeply"),
+    ("digits", lambda t: t.replace("mass_kg = ", "mass_kg = " + "1" * 5000 + "#", 1), "digits"),
+    ("zeros", lambda t: t.replace("mass_kg = ", "mass_kg = 1" + "0" * 400 + "#", 1), "mass_kg"),
+    ("control", lambda t: t.replace('description = "', 'description = "a\\u0001b', 1), "control character"),
+    ("control_name", lambda t: t.replace('name = "tractor"', 'name = "trac\\u001btor"', 1), "name"),
+    ("huge", lambda t: t + "#" * (2 << 20), "bytes"),
+])
+def test_pathological_vehicle_files_are_one_line_exit_2_and_quick(tmp_path, name, make, fragment):
+    path = _variant(tmp_path, name, make)
+    t0 = time.perf_counter()
+    p = lcv_process("eig", "--vehicle", path, "--speed-kph", "88")
+    assert time.perf_counter() - t0 < 10
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1 and fragment in p.stderr, p.stderr
+    assert "internal error" not in p.stderr
+
+
+@pytest.mark.parametrize("special", ["fifo", "/dev/zero", "folder"])
+def test_a_vehicle_file_that_is_not_a_regular_file_is_refused_without_reading_it(tmp_path, special):
+    path = special
+    if special == "fifo":
+        path = str(tmp_path / "fifo")
+        os.mkfifo(path)
+    elif special == "folder":
+        path = str(tmp_path)
+    p = lcv_process("eig", "--vehicle", path, "--speed-kph", "88")
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
+
+
+def test_the_number_of_units_is_bounded():
+    from lcvreport.model.vehicle import Vehicle, VehicleError
+    unit = load_vehicle(WESTERN).units[1]
+    with pytest.raises(VehicleError, match="at most 50 units"):
+        Vehicle("long", tuple(unit for _ in range(51)))
+
+
+def test_version():
+    p = lcv_process("--version")
+    assert p.returncode == 0 and p.stdout.startswith("lcv (lcvreport) ")
+
+
+def test_ctrl_c_is_one_line_and_status_130(tmp_path):
+    import signal
+    exe = shutil.which("lcv", path=os.path.dirname(sys.executable))
+    out = tmp_path / "run.csv"
+    with open(out, "w") as f:
+        proc = subprocess.Popen([exe, "simulate", "--preset", "aucnat", "--speed-kph", "88", "--load", "trailer3",
+                                 "--t-end", "5000", "--dt", "0.001"], stdout=f, stderr=subprocess.PIPE, text=True)
+        time.sleep(3.0)
+        proc.send_signal(signal.SIGINT)
+        _out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and err.strip().splitlines() == ["lcv: interrupted"], err

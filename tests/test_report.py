@@ -350,3 +350,81 @@ def test_markdown_cells_have_no_stray_emphasis():
             if cell.cell_type == "markdown":
                 text = cell.source.replace("**", "")
                 assert not re.search(r"\w\*\w", text), (path.name, cell.id, text)
+
+
+# ---------------------------------------------------------------------------- the output folder (issue 22)
+def _tree(folder: Path) -> dict:
+    return {str(p.relative_to(folder)): (p.read_bytes() if p.is_file() else None)
+            for p in sorted(folder.rglob("*"))}
+
+
+def test_a_folder_with_files_the_report_did_not_write_is_refused_untouched(tmp_path):
+    """--out holding a data/ folder, an index.html and the vehicle file itself: before,
+    data/ was removed, index.html deleted and the vehicle file overwritten, exit 0."""
+    out = tmp_path / "work"
+    (out / "data").mkdir(parents=True)
+    (out / "data" / "mine.csv").write_text("a,b\n1,2\n")
+    (out / "index.html").write_text("<p>my page</p>")
+    vehicle = out / "vehicle.toml"
+    vehicle.write_text("# my comments\n" + (EXAMPLES / "western_double.toml").read_text())
+    before = _tree(out)
+    p = _lcv("report", "--vehicle", str(vehicle), "--out", str(out))
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1 and "not empty" in p.stderr, p.stderr
+    assert _tree(out) == before
+    assert not [q for q in tmp_path.iterdir() if q.name.startswith(".")]
+
+
+@pytest.mark.xdist_group("assessment")
+def test_the_vehicle_file_is_copied_as_written(assessment):
+    name, out, _p = assessment
+    if name == "western_double":
+        assert (out / "vehicle.toml").read_bytes() == (EXAMPLES / "western_double.toml").read_bytes()
+    manifest = json.loads((out / ".lcv-report.json").read_text())
+    assert sorted(manifest["files"]) == sorted(q.name for q in out.iterdir())
+    assert (out / "mathjax").is_symlink()
+
+
+def test_an_earlier_report_is_replaced_whole_and_a_foreign_file_beside_it_is_refused(tmp_path):
+    out = tmp_path / "r"
+    args = ["--preset", "tractor_semitrailer", "--no-pdf", "--out", str(out)]
+    assert _lcv("report", *args).returncode == 0
+    first = _tree(out)
+    p = _lcv("report", *args[:2], "--speed-kph", "60", *args[2:])
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert "at 60 km/h" in (out / "index.html").read_text(encoding="utf-8")
+    assert set(_tree(out)) == set(first)
+    (out / "notes.txt").write_text("mine")
+    p = _lcv("report", *args)
+    assert p.returncode == 2 and "notes.txt" in p.stderr, p.stderr
+    assert (out / "notes.txt").read_text() == "mine"
+    assert not [q for q in tmp_path.iterdir() if q.name.startswith(".")]
+
+
+def test_ctrl_c_ends_a_report_with_one_line_and_leaves_nothing(tmp_path):
+    import os
+    import signal
+    import time
+    out = tmp_path / "r"
+    proc = subprocess.Popen([sys.executable, "-m", "lcvreport.cli", "report", "--preset", "aucnat", "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    time.sleep(6.0)                                   # inside the notebook
+    os.killpg(proc.pid, signal.SIGINT)                # what Ctrl-C sends: the whole foreground group
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (proc.returncode, stderr[-3000:])
+    assert "Traceback" not in stderr and stderr.strip().splitlines()[-1].startswith("lcv: interrupted"), stderr
+    assert not out.exists()
+    assert not list(tmp_path.iterdir())
+
+
+def test_two_reports_into_one_folder_at_once_leave_one_whole_report(tmp_path):
+    out = tmp_path / "r"
+    runs = [subprocess.Popen([sys.executable, "-m", "lcvreport.cli", "report", *src, "--no-pdf", "--out", str(out)],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            for src in (["--preset", "tractor_semitrailer"], ["--vehicle", str(EXAMPLES / "b_double.toml")])]
+    results = [(r.wait(timeout=600), r.stderr.read()) for r in runs]
+    assert sorted(code for code, _ in results) in ([0, 1], [0, 2]), results
+    html = (out / "index.html").read_text(encoding="utf-8")
+    winner = "tractor_semitrailer" if results[0][0] == 0 else "b_double"
+    loser = "b_double" if winner == "tractor_semitrailer" else "tractor_semitrailer"
+    assert f"assessment of {winner}" in html and f"assessment of {loser}" not in html
+    assert not [q for q in tmp_path.iterdir() if q.name.startswith(".")]

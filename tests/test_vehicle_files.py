@@ -112,7 +112,7 @@ def test_unreadable_and_not_toml_files_are_named(tmp_path):
         load_vehicle(bad)
     binary = tmp_path / "binary.toml"
     binary.write_bytes(b"\xff\xfe\x00")
-    with pytest.raises(VehicleFileError, match="cannot read"):
+    with pytest.raises(VehicleFileError, match="not UTF-8 text"):
         load_vehicle(binary)
 
 

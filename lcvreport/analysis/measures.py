@@ -39,7 +39,7 @@ import numpy as np
 from ..model.builder import check_speed, check_tire_scale, system_coefficients
 from ..model.loads import load_vector, one_percent_rule
 from ..model.vehicle import Vehicle
-from ..ranges import RANGES
+from ..ranges import RANGES, RangeError
 from ..units import kph_to_mps, mps_to_kph
 from .geometry import point_lateral_map, point_longitudinal
 from .modes import eigenvalues, state_matrix
@@ -414,21 +414,26 @@ class MeasureSet:
     least_damping_ratio: float | None
     least_damped_frequency_hz: float | None
     critical_speed_kph: float | None
-    ra_frequency: float
-    ra_single_sine: float
-    ay_gain_per_unit: list[float]
+    ra_frequency: float | None
+    ra_single_sine: float | None
+    ay_gain_per_unit: list[float] | None
     trim: Trim | None = None
     load_units: tuple[str, ...] = ()
     f_hz: float = RA_FREQUENCY_HZ
+    #: measure key -> why it is null (e.g. no steered axle: no steer input to respond to)
+    undefined: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """The SPEC section 8 JSON document."""
         doc = {"speed_mps": self.speed_mps, "least_damping_ratio": self.least_damping_ratio,
                "least_damped_frequency_hz": self.least_damped_frequency_hz,
                "critical_speed_kph": self.critical_speed_kph, "ra_frequency": self.ra_frequency,
-               "ra_single_sine": self.ra_single_sine, "ay_gain_per_unit": list(self.ay_gain_per_unit)}
+               "ra_single_sine": self.ra_single_sine,
+               "ay_gain_per_unit": None if self.ay_gain_per_unit is None else list(self.ay_gain_per_unit)}
         if self.trim is not None:
             doc["trim"] = {"delta_rad": self.trim.delta_rad, "offtracking_m": self.trim.offtracking_m}
+        elif "trim" in self.undefined:
+            doc["trim"] = None
         return doc
 
     def rows(self) -> list[dict]:
@@ -445,13 +450,21 @@ class MeasureSet:
                  "note": "Im λ/2π of that mode", "json_key": "least_damped_frequency_hz"},
                 {"measure": "critical speed", "value": num(self.critical_speed_kph), "unit": "km/h",
                  "note": "lowest unstable speed up to 200 km/h (none: stable)", "json_key": "critical_speed_kph"},
-                {"measure": f"rearward amplification, {f}", "value": self.ra_frequency, "unit": "-",
-                 "note": "|G_N| / |G_1|, frequency domain", "json_key": "ra_frequency"},
-                {"measure": "rearward amplification, single sine", "value": self.ra_single_sine, "unit": "-",
-                 "note": f"max|a_N| / max|a_1|, {f} single sine", "json_key": "ra_single_sine"}]
-        for k, (name, g) in enumerate(zip(self.vehicle.unit_names, self.ay_gain_per_unit)):
+                {"measure": f"rearward amplification, {f}", "value": num(self.ra_frequency), "unit": "-",
+                 "note": self.undefined.get("ra_frequency", "|G_N| / |G_1|, frequency domain"),
+                 "json_key": "ra_frequency"},
+                {"measure": "rearward amplification, single sine", "value": num(self.ra_single_sine), "unit": "-",
+                 "note": self.undefined.get("ra_single_sine", f"max|a_N| / max|a_1|, {f} single sine"),
+                 "json_key": "ra_single_sine"}]
+        if self.ay_gain_per_unit is None:
+            rows.append({"measure": "lateral acceleration gains", "value": "none", "unit": "m/s²/rad",
+                         "note": self.undefined.get("ay_gain_per_unit", ""), "json_key": "ay_gain_per_unit"})
+        for k, (name, g) in enumerate(zip(self.vehicle.unit_names, self.ay_gain_per_unit or ())):
             rows.append({"measure": f"lateral acceleration gain, {name}", "value": g, "unit": "m/s²/rad",
                          "note": f"|G_{k + 1}(j2π·{f})|", "json_key": f"ay_gain_per_unit[{k}]"})
+        if "trim" in self.undefined:
+            rows.append({"measure": "trim", "value": "none", "unit": "", "note": self.undefined["trim"],
+                         "json_key": "trim"})
         if self.trim is not None:
             rows.append({"measure": "trim steer angle", "value": self.trim.delta_rad, "unit": "rad",
                          "note": f"1 % rule on {', '.join(self.load_units)}", "json_key": "trim.delta_rad"})
@@ -475,14 +488,37 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
         Frequency of the RA measures and gains [Hz].
     """
     zeta, f_zeta = least_damping(vehicle, speed_mps, tire_scale)
+    units = tuple(load_units) if load_units else ()
+    if not vehicle.steered_axles:
+        why = "undefined: the vehicle has no steered axle, so no steer input to respond to or trim with"
+        undefined = {k: why for k in ("ra_frequency", "ra_single_sine", "ay_gain_per_unit")}
+        if units:
+            undefined["trim"] = why
+        return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
+                          critical_speed(vehicle, tire_scale), None, None, None, None, units, float(f_hz), undefined)
     gains = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
     ss = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale)
     tr = None
-    units = ()
-    if load_units:
-        units = tuple(load_units)
+    if units:
         F = load_vector(vehicle, one_percent_rule(vehicle, list(units)))
         tr = trim(vehicle, speed_mps, F, tire_scale)
+        check_trim(tr)
     return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
                       critical_speed(vehicle, tire_scale), float(gains[-1] / gains[0]), ss.rearward_amplification,
                       [float(g) for g in gains], tr, units, float(f_hz))
+
+
+def check_trim(tr: Trim) -> None:
+    """Refuse a trim outside the ranges table: a trim steer beyond [-1, 1] rad is no longer
+    a small angle, and the linear model's answer means nothing (a unit typo, such as a
+    cornering stiffness in kN/rad, is the usual cause).
+
+    Raises
+    ------
+    RangeError
+    """
+    r = RANGES["steer_angle"]
+    if not r.contains(tr.delta_rad):
+        raise RangeError("trim.delta_rad", f"the trim steer angle {tr.delta_rad:.4g} rad is outside {r.text()}: the "
+                                           "linear model does not hold there; check the vehicle file's units "
+                                           "(cornering stiffness per tire in N/rad, masses in kg)")

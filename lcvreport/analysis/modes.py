@@ -168,9 +168,9 @@ def eigenvalues(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: flo
 
 
 def _modes_one(vehicle: Vehicle, speed: float, tire_scale: float) -> Modes:
-    import scipy.linalg
-    co = system_coefficients(vehicle)
-    lam, X = scipy.linalg.eig(co.S(speed, tire_scale), co.M(speed))
+    # the same routine as eigenvalues(): the balanced, scaled state matrix (QZ on the
+    # unscaled pencil (S, M) lost up to two digits on long chains)
+    lam, X = np.linalg.eig(state_matrix(vehicle, speed, tire_scale))
     order = mode_order(lam)
     lam, X = lam[order], X[:, order]
     k = np.argmax(np.abs(X), axis=0)

@@ -259,6 +259,9 @@ class Vehicle:
             raise VehicleError("units", f"units must be a list of Unit, got {self.units!r}")
         if not units:
             raise VehicleError("units", "a vehicle needs at least one unit, got none")
+        if len(units) > VEHICLE["units"].high:
+            raise VehicleError("units", f"a vehicle has at most {VEHICLE['units'].high:.0f} units "
+                                        f"({VEHICLE['units'].description}), got {len(units)}")
         object.__setattr__(self, "units", units)
         if not isinstance(self.description, str):
             raise VehicleError("description", f"description must be text, got {self.description!r}")

@@ -59,13 +59,20 @@ lcvreport.model.vehicle_file.VehicleFileError: units[0] "truck" axles[0] "front"
 """
 from __future__ import annotations
 
+import os
+import stat
 import tomllib
+import unicodedata
 from pathlib import Path
 
 from .vehicle import Axle, Unit, Vehicle, VehicleError
 
 #: the format tag of version 1
 FORMAT = "lcv-vehicle/1"
+#: the largest vehicle file read [bytes] (a 100-unit road train with comments is ~60 kB)
+MAX_FILE_BYTES = 1 << 20
+#: the deepest nesting of tables and arrays a vehicle file needs is 4; TOML deeper than this is refused
+MAX_DEPTH = 16
 
 #: keys of the top level, a unit and an axle: (required, optional)
 TOP_KEYS = (("format", "name", "units"), ("description",))
@@ -81,12 +88,41 @@ class VehicleFileError(VehicleError):
 
 def _keys(table: dict, spec: tuple, where: str) -> None:
     required, optional = spec
+    for key, value in table.items():
+        if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 64:
+            raise VehicleFileError(key, f"{key} must be a number of physical size, got an integer of "
+                                        f"{len(str(abs(value)))} digits", where)
+        if isinstance(value, str):
+            _printable(key, value, where)
     for key in table:
         if key not in required and key not in optional:
             raise VehicleFileError(key, f"unknown key {key!r}; valid keys: {', '.join(required + optional)}", where)
     for key in required:
         if key not in table:
             raise VehicleFileError(key, f"missing key {key!r}", where)
+
+
+def _printable(key: str, text: str, where: str) -> None:
+    """Text that goes into XML, C sources and reports: no control characters."""
+    for ch in text:
+        if unicodedata.category(ch) in ("Cc", "Cs", "Co", "Cn"):
+            raise VehicleFileError(key, f"{key} must be printable text, got the control character "
+                                        f"U+{ord(ch):04X} in {text[:60]!r}", where)
+
+
+def _depth(value, limit: int = MAX_DEPTH) -> int:
+    """Nesting depth of a parsed TOML value, without recursion (a file may nest 10^4 deep)."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        v, d = stack.pop()
+        deepest = max(deepest, d)
+        if deepest > limit:
+            return deepest
+        if isinstance(v, dict):
+            stack.extend((x, d + 1) for x in v.values())
+        elif isinstance(v, list):
+            stack.extend((x, d + 1) for x in v)
+    return deepest
 
 
 def _table_list(value, key: str, where: str) -> list[dict]:
@@ -105,6 +141,8 @@ def vehicle_from_dict(doc: dict, source: str = "") -> Vehicle:
     """
     if not isinstance(doc, dict):
         raise VehicleFileError("", "a vehicle file must be a TOML document")
+    if _depth(doc) > MAX_DEPTH:
+        raise VehicleFileError("", f"tables or arrays are nested more than {MAX_DEPTH} deep; a vehicle file needs 4")
     _keys(doc, TOP_KEYS, "")
     if doc["format"] != FORMAT:
         raise VehicleFileError("format", f"format must be {FORMAT!r}, got {doc['format']!r}")
@@ -134,11 +172,64 @@ def vehicle_from_dict(doc: dict, source: str = "") -> Vehicle:
 
 def loads_vehicle(text: str, source: str = "") -> Vehicle:
     """Parse vehicle-file text (TOML); see :func:`vehicle_from_dict`."""
+    if len(text) > MAX_FILE_BYTES:
+        raise VehicleFileError("", f"the text is {len(text)} characters long; a vehicle file has at most "
+                                   f"{MAX_FILE_BYTES} bytes")
+    _check_key_lengths(text)
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise VehicleFileError("", f"not valid TOML: {exc}") from None
+    except (RecursionError, MemoryError):
+        raise VehicleFileError("", "not a vehicle file: its TOML nests too deeply") from None
+    except ValueError as exc:          # e.g. an integer beyond Python's digit limit
+        raise VehicleFileError("", f"not valid TOML: {exc}") from None
     return vehicle_from_dict(doc, source)
+
+
+def _check_key_lengths(text: str) -> None:
+    """Refuse dotted keys of more than :data:`MAX_DEPTH` parts before parsing (tomllib takes
+    time quadratic in the parts: a 40,000-part key would hang it)."""
+    for number, line in enumerate(text.splitlines(), 1):
+        stripped = line.lstrip()
+        key = stripped.split("]", 1)[0] if stripped.startswith("[") else stripped.split("=", 1)[0]
+        if key.count(".") >= MAX_DEPTH:
+            raise VehicleFileError("", f"line {number}: a key of {key.count('.') + 1} dotted parts; a vehicle file "
+                                       f"needs at most 3")
+
+
+def read_vehicle_text(path: str | Path) -> str:
+    """The text of a vehicle file: a regular file of at most :data:`MAX_FILE_BYTES`, UTF-8.
+
+    A FIFO, a device (``/dev/zero``) or a folder is refused without reading from it.
+
+    Raises
+    ------
+    VehicleFileError
+    """
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as exc:
+        raise VehicleFileError("", f"cannot read {path}: {exc.strerror}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise VehicleFileError("", f"{path} is not a regular file (a vehicle file is a TOML text file)")
+        if st.st_size > MAX_FILE_BYTES:
+            raise VehicleFileError("", f"{path} has {st.st_size} bytes; a vehicle file has at most {MAX_FILE_BYTES}")
+        with os.fdopen(fd, "rb", closefd=False) as f:
+            data = f.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise VehicleFileError("", f"cannot read {path}: {exc.strerror}") from None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_FILE_BYTES:
+        raise VehicleFileError("", f"{path} has more than {MAX_FILE_BYTES} bytes")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise VehicleFileError("", f"{path} is not UTF-8 text ({exc.reason} at byte {exc.start})") from None
 
 
 def load_vehicle(path: str | Path) -> Vehicle:
@@ -165,13 +256,7 @@ def load_vehicle(path: str | Path) -> Vehicle:
     >>> v.unit_names
     ('tractor', 'trailer1', 'dolly', 'trailer2')
     """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise VehicleFileError("", f"cannot read {path}: {exc.strerror if isinstance(exc, OSError) else exc}") \
-            from None
-    return loads_vehicle(text, source=str(path))
+    return loads_vehicle(read_vehicle_text(path), source=str(path))
 
 
 def _value(v) -> str:

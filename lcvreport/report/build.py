@@ -53,6 +53,8 @@ DEFAULT_SPEED_KPH = 88.0
 HTML_ONLY = "lcv-html-only"
 #: the kernel logs errors only (its TCP-on-localhost warning is not the reader's concern)
 KERNEL_ARGS = ["--IPKernelApp.log_level=CRITICAL"]
+#: paper sizes of the PDF (LaTeX geometry names)
+PAPERS = ("letter", "a4")
 
 
 class ReportError(RuntimeError):
@@ -211,6 +213,8 @@ def execute(stem: str, out_dir: Path, parameters: dict, source_dir: Path | None 
         pm.execute_notebook(str(src), str(dst), parameters=parameters, kernel_name="python3",
                             cwd=str(out_dir), progress_bar=False, log_output=False, extra_arguments=KERNEL_ARGS)
     except pm.PapermillExecutionError as exc:
+        if exc.ename == "KeyboardInterrupt":     # Ctrl-C reached the kernel too: an interruption, not a failure
+            raise KeyboardInterrupt from None
         where = _failed_cell(src, dst, exc.cell_index)
         raise ReportError(f"notebook {src.name} failed in {where}: {exc.ename}: {exc.evalue} "
                           f"(executed copy: {dst})") from None
@@ -275,15 +279,16 @@ def export_html(nb, out_dir: Path) -> Path:
     body, _ = exporter.from_notebook_node(nb)
     body = body.replace('<script src=""></script>', "")
     if MATHJAX.exists():
+        # one copy on the machine (Debian's libjs-mathjax, 32 MB), linked, not copied per report
         dst = out_dir / "mathjax"
-        if not dst.exists():
-            shutil.copytree(MATHJAX, dst, symlinks=False, ignore=shutil.ignore_patterns("unpacked", "test"))
+        if not dst.exists() and not dst.is_symlink():
+            dst.symlink_to(MATHJAX, target_is_directory=True)
     path = out_dir / "index.html"
     path.write_text(body, encoding="utf-8")
     return path
 
 
-def export_pdf(nb, out_dir: Path, author: str) -> Path:
+def export_pdf(nb, out_dir: Path, author: str, paper: str = "letter") -> Path:
     """PDF through nbconvert's LaTeX route (xelatex) with the lcvlatex template; the LaTeX
     log of the last run is kept as ``latex.log`` beside it (see :func:`overfull_boxes`)."""
     from nbconvert import PDFExporter
@@ -301,7 +306,8 @@ def export_pdf(nb, out_dir: Path, author: str) -> Path:
                          exclude_input_prompt=True, exclude_output_prompt=True)
     exporter.latex_command = ["xelatex", "-interaction=batchmode", "-halt-on-error", "{filename}"]
     try:
-        pdf, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": "report"}, "lcv_author": author})
+        pdf, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": "report"}, "lcv_author": author,
+                                                              "lcv_paper": paper})
     except Exception as exc:  # nbconvert raises LatexFailed with the log
         raise ReportError(f"PDF export (xelatex) failed: {str(exc)[-2000:]}") from None
     path = out_dir / "report.pdf"
@@ -402,10 +408,95 @@ def _execute_unchecked(stem, nb_dir, params, src):
     return dst
 
 
+#: the manifest an assessment report leaves in its folder: the names it wrote
+MANIFEST = ".lcv-report.json"
+
+
+class OutputFolderError(ReportError):
+    """``--out`` names a folder the report may not write into (a usage error)."""
+
+
+def check_output_folder(out_dir: str | Path) -> Path:
+    """The folder an assessment report may be written to, resolved.
+
+    A report goes into a new folder, an empty one, or the folder of an earlier report
+    (every entry in it listed in that report's manifest, so replacing it removes nothing
+    a person put there).  Anything else is refused: a report never removes or rewrites a
+    file it did not write.
+
+    Raises
+    ------
+    OutputFolderError
+        Naming the folder and what is in the way.
+    """
+    import json
+    out = Path(out_dir).resolve()
+    if out.exists() and not out.is_dir():
+        raise OutputFolderError(f"--out {out_dir}: exists and is not a folder")
+    if not out.exists():
+        if not out.parent.is_dir():
+            raise OutputFolderError(f"--out {out_dir}: its parent folder {out.parent} does not exist")
+        return out
+    entries = sorted(p.name for p in out.iterdir())
+    if not entries:
+        return out
+    manifest = out / MANIFEST
+    try:
+        owned = set(json.loads(manifest.read_text(encoding="utf-8"))["files"]) | {MANIFEST}
+    except (OSError, ValueError, KeyError, TypeError):
+        raise OutputFolderError(f"--out {out_dir}: the folder is not empty ({', '.join(entries[:3])}"
+                                f"{', ...' if len(entries) > 3 else ''}) and holds no report written by lcv report; "
+                                "give a new or empty folder") from None
+    foreign = [e for e in entries if e not in owned]
+    if foreign:
+        raise OutputFolderError(f"--out {out_dir}: besides an earlier report the folder holds "
+                                f"{', '.join(foreign[:3])}{', ...' if len(foreign) > 3 else ''}, which lcv report did "
+                                "not write; give a new or empty folder")
+    return out
+
+
+def _publish(staged: Path, out: Path, existed_as: tuple) -> None:
+    """Move the finished report ``staged`` into place as ``out`` (renames on one file
+    system: a reader sees the old report or the new one, never a mix)."""
+    import os
+    now = _folder_state(out)
+    if now != existed_as:
+        raise ReportError(f"{out} changed while the report was being written (another report into the same "
+                          "folder?); nothing was replaced")
+    if now[0] == "report":
+        aside = out.with_name(f".{out.name}.replaced-{os.getpid()}")
+        os.rename(out, aside)
+        try:
+            os.rename(staged, out)
+        except OSError:
+            os.rename(aside, out)
+            raise
+        shutil.rmtree(aside, ignore_errors=True)
+    else:
+        os.rename(staged, out)     # replaces an empty folder atomically; fails if one appeared meanwhile
+
+
+def _folder_state(out: Path) -> tuple:
+    if not out.exists():
+        return ("absent",)
+    entries = sorted(p.name for p in out.iterdir())
+    if not entries:
+        return ("empty",)
+    try:
+        return ("report", (out / MANIFEST).read_bytes())
+    except OSError:
+        return ("other", tuple(entries))
+
+
 def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = None, load_units=None,
                      pdf: bool = True, progress: Callable[[str], None] | None = None, fast: bool = False,
-                     source: str = "") -> dict:
+                     source: str = "", vehicle_text: str | None = None, paper: str = "letter") -> dict:
     """The assessment report of ``vehicle`` (SPEC section 10) into ``out_dir``.
+
+    The report is written into a hidden folder beside ``out_dir`` and moved into place
+    whole when it is complete; ``out_dir`` must be new, empty or an earlier report
+    (:func:`check_output_folder`).  An interrupted or failed build leaves ``out_dir`` as
+    it was.
 
     Parameters
     ----------
@@ -424,38 +515,69 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         Coarser grids (tests).
     source : str
         Where the vehicle came from, for the report.
+    vehicle_text : str, optional
+        The vehicle file as the user wrote it (copied as is, comments kept); default: the
+        vehicle written out.
+    paper : {"letter", "a4"}
+        Paper size of the PDF.
 
     Returns
     -------
     dict
-        ``html``, ``pdf``, ``data`` paths and ``seconds``.
+        ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
     """
+    import json
+    import os
+    import tempfile
     from ..model.vehicle_file import dumps_vehicle
+    from importlib.metadata import version
+    __version__ = version("lcvreport")
+    if paper not in PAPERS:
+        raise OutputFolderError(f"paper must be one of {', '.join(PAPERS)}, got {paper!r}")
     progress = progress or (lambda _text: None)
-    out_dir, data_dir = _prepare(Path(out_dir).resolve())
-    speed_kph = DEFAULT_SPEED_KPH if speed_mps is None else speed_mps / MPS_PER_KPH
-    vehicle_file = out_dir / "vehicle.toml"
-    vehicle_file.write_text(dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name})."),
-                            encoding="utf-8")
-    params = {"fast": bool(fast), "data_dir": str(data_dir), "preset": None, "vehicle_file": str(vehicle_file),
-              "speed_kph": float(speed_kph), "load_units": list(load_units) if load_units else None}
-    t0 = time.perf_counter()
-    nb_dir = out_dir / "notebooks"
-    nb_dir.mkdir(exist_ok=True)
-    path = execute("assessment", nb_dir, params)
-    progress(f"notebook assessment: {time.perf_counter() - t0:.1f} s")
-    title = f"Yaw-plane assessment of {vehicle.name} at {speed_kph:g} km/h"
-    intro = (f"Linear yaw-plane model of `{vehicle.name}` ({vehicle.n_units} units: {', '.join(vehicle.unit_names)})"
-             f"{' from ' + source if source else ''}, assessed at {speed_kph:g} km/h with `lcvreport` "
-             "(SI units; speeds in km/h).")
-    nb = merge([("assessment", "assessment", title, path)], title, intro)
-    out = {"html": export_html(nb, out_dir), "data": data_dir}
-    progress("html written")
-    if pdf:
-        out["pdf"] = export_pdf(nb, out_dir, f"lcvreport assessment of {vehicle.name}")
-        progress("pdf written")
-    out["seconds"] = time.perf_counter() - t0
-    return out
+    out = check_output_folder(out_dir)
+    before = _folder_state(out)
+    staged = Path(tempfile.mkdtemp(prefix=f".{out.name}.writing-", dir=out.parent))
+    try:
+        data_dir = staged / "data"
+        data_dir.mkdir()
+        speed_kph = DEFAULT_SPEED_KPH if speed_mps is None else speed_mps / MPS_PER_KPH
+        vehicle_file = staged / "vehicle.toml"
+        text = vehicle_text if vehicle_text is not None else \
+            dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name}).")
+        vehicle_file.write_text(text, encoding="utf-8")
+        params = {"fast": bool(fast), "data_dir": str(data_dir), "preset": None, "vehicle_file": str(vehicle_file),
+                  "speed_kph": float(speed_kph), "load_units": list(load_units) if load_units else None}
+        t0 = time.perf_counter()
+        nb_dir = staged / "notebooks"
+        nb_dir.mkdir()
+        path = execute("assessment", nb_dir, params)
+        progress(f"notebook assessment: {time.perf_counter() - t0:.1f} s")
+        title = f"Yaw-plane assessment of {vehicle.name} at {speed_kph:g} km/h"
+        stamp = time.strftime("%Y-%m-%d", time.gmtime(int(os.environ.get("SOURCE_DATE_EPOCH", time.time()))))
+        description = f"\n\n> {vehicle.description}" if vehicle.description else ""
+        intro = (f"Linear yaw-plane model of *{vehicle.name}* ({vehicle.n_units} units: "
+                 f"{', '.join(vehicle.unit_names)}){' from ' + source if source else ''}, assessed at {speed_kph:g} km/h "
+                 f"(SI units; speeds in km/h). Written by lcvreport {__version__} on {stamp}.{description}")
+        nb = merge([("assessment", "assessment", title, path)], title, intro)
+        html = export_html(nb, staged)
+        progress("html written")
+        written = {"html": "index.html", "data": "data"}
+        if pdf:
+            export_pdf(nb, staged, f"lcvreport {__version__} assessment of {vehicle.name}", paper=paper)
+            written["pdf"] = "report.pdf"
+            progress("pdf written")
+        files = sorted(p.name for p in staged.iterdir()) + [MANIFEST]
+        (staged / MANIFEST).write_text(json.dumps({"written_by": f"lcvreport {__version__} (lcv report)",
+                                                   "files": files}, indent=1), encoding="utf-8")
+        _publish(staged, out, before)
+    except BaseException:
+        shutil.rmtree(staged, ignore_errors=True)
+        raise
+    res = {key: out / name for key, name in written.items()}
+    res["seconds"] = time.perf_counter() - t0
+    del html
+    return res
 
 
 def main(argv: list[str] | None = None) -> int:
