@@ -147,6 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
     fmu.add_argument("--out", required=True, metavar="DIR", help="output folder")
     fmu.add_argument("--kind", default="both", choices=("python", "native", "both"),
                      help="python (pythonfmu), native (C99) or both (default)")
+    speed(fmu, required=False)
     rep = sub.add_parser("report", help="assessment report of the vehicle (HTML and PDF)")
     source(rep, masses=False)
     speed(rep, required=False)
@@ -400,7 +401,10 @@ def _cmd_fmu(args, out: _Out) -> int:
     from .fmu.build import FmuBuildError, build_vehicle_fmus
     v = _vehicle(args)
     try:
-        paths = build_vehicle_fmus(v, args.out, kind=args.kind)
+        kw = {}
+        if args.speed_kph is not None or args.speed_mph is not None:
+            kw["u_start_mps"] = _speed_mps(args)      # the start value of the input u
+        paths = build_vehicle_fmus(v, args.out, kind=args.kind, **kw)
     except FmuBuildError as exc:
         raise OutputError(str(exc)) from None
     for p in paths:

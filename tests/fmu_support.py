@@ -21,9 +21,11 @@ from lcvreport.model.vehicle_file import loads_vehicle
 def interface_of(path: Path):
     """The interface table an FMU was built from (preset FMUs: SPEC 5; else its vehicle)."""
     names = zipfile.ZipFile(path).namelist()
-    if "resources/vehicle.toml" in names:
-        return vehicle_interface(loads_vehicle(zipfile.ZipFile(path).read("resources/vehicle.toml").decode()))
     root = ET.fromstring(zipfile.ZipFile(path).read("modelDescription.xml"))
+    if "resources/vehicle.toml" in names:
+        u_start = next(float(sv[0].get("start")) for sv in root.iter("ScalarVariable") if sv.get("name") == "u")
+        return vehicle_interface(loads_vehicle(zipfile.ZipFile(path).read("resources/vehicle.toml").decode()),
+                                 u_start)
     if any(sv.get("name") == "preset" for sv in root.iter("ScalarVariable")):
         return preset_interface()
     raise AssertionError(f"{path}: not an FMU of this project")

@@ -428,3 +428,44 @@ def test_two_reports_into_one_folder_at_once_leave_one_whole_report(tmp_path):
     loser = "b_double" if winner == "tractor_semitrailer" else "tractor_semitrailer"
     assert f"assessment of {winner}" in html and f"assessment of {loser}" not in html
     assert not [q for q in tmp_path.iterdir() if q.name.startswith(".")]
+
+
+@pytest.mark.xdist_group("assessment")
+def test_figure_csvs_hold_engineering_data_with_units_and_no_nan(assessment):
+    """Not the plotting library's objects (_child3, 52,506 rows) and no NaN rows."""
+    _name, out, _p = assessment
+    for path in sorted((out / "data").glob("figure_*.csv")):
+        text = path.read_text()
+        header = text.splitlines()[0]
+        assert "_child" not in text and "nan" not in text.lower().replace("nano", ""), path.name
+        assert not header.startswith("axes,artist"), (path.name, header)
+        assert len(text.splitlines()) < 20_000, path.name
+
+
+@pytest.mark.xdist_group("assessment")
+def test_page_one_has_the_summary_and_the_report_says_its_version(assessment):
+    name, out, _p = assessment
+    page1 = subprocess.run(["pdftotext", "-l", "1", str(out / "report.pdf"), "-"], capture_output=True,
+                           text=True).stdout
+    assert "Summary" in page1 and "least damping ratio" in page1 and "Written by lcvreport" in page1
+    assert "`" not in subprocess.run(["pdftotext", str(out / "report.pdf"), "-"], capture_output=True,
+                                     text=True).stdout
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert ".writing-" not in html                    # captions name the user's file, not the staging folder
+
+
+def test_a_vehicle_without_a_steered_axle_gets_a_report_saying_what_is_not_computed(tmp_path):
+    path = tmp_path / "nosteer.toml"
+    path.write_text((EXAMPLES / "western_double.toml").read_text().replace("steered = true\n", ""))
+    out = tmp_path / "r"
+    p = _lcv("report", "--vehicle", str(path), "--no-pdf", "--out", str(out))
+    assert p.returncode == 0, p.stderr[-3000:]
+    assert "no steered axle" in (out / "index.html").read_text(encoding="utf-8")
+
+
+def test_a4_paper(tmp_path):
+    out = tmp_path / "r"
+    p = _lcv("report", "--preset", "tractor_semitrailer", "--paper", "a4", "--out", str(out))
+    assert p.returncode == 0, p.stderr[-3000:]
+    info = subprocess.run(["pdfinfo", str(out / "report.pdf")], capture_output=True, text=True).stdout
+    assert "595.276 x 841.89 pts (A4)" in info or "595.28 x 841.89" in info, info

@@ -179,3 +179,18 @@ def test_interface_only_stub_twin_has_the_same_interface(western_fmus, tmp_path)
     assert [v[:7] for v in _variables(stub)] == [v[:7] for v in _variables(western_fmus["native"])]
     res = fmpy.simulate_fmu(str(stub), stop_time=0.1, step_size=0.01, output=["Y1"])
     assert res["time"][-1] == pytest.approx(0.1)
+
+
+def test_the_start_speed_of_u_follows_lcv_fmu_speed(tmp_path):
+    """The assessment report documents its FMUs at its own speed (before: 50 mph whatever
+    the report's speed): ``lcv fmu --speed-kph V`` starts u at V, in both kinds."""
+    from lcvreport.analysis.modes import modes
+    p = subprocess.run([sys.executable, "-m", "lcvreport.cli", "fmu", "--vehicle", str(EXAMPLES / "b_double.toml"),
+                        "--speed-kph", "88", "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    vehicle = load_vehicle(EXAMPLES / "b_double.toml")
+    for fmu in (tmp_path / "b_double.fmu", tmp_path / "b_doubleNative.fmu"):
+        starts = {v[0]: v[6] for v in _variables(fmu)}
+        assert float(starts["u"]) == pytest.approx(88 / 3.6, rel=1e-15)
+        res = fmpy.simulate_fmu(str(fmu), stop_time=0.02, step_size=0.01, output=["max_real_eig"])
+        assert res["max_real_eig"][-1] == pytest.approx(modes(vehicle, 88 / 3.6).max_real, rel=1e-9)

@@ -41,7 +41,7 @@ from ..model.vehicle import Vehicle
 from ..model.vehicle_file import dumps_vehicle
 from ..ranges import RANGES
 from .engine import STATE_MAGIC, LCVEngine
-from .interface import Interface, U_MIN_DEFAULT, preset_interface, vehicle_interface
+from .interface import U_START, Interface, U_MIN_DEFAULT, preset_interface, vehicle_interface
 from .model_description import guid, model_description
 
 #: compile flags of the native FMU and the loader
@@ -328,7 +328,9 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
         proj = tmp / "project"
         proj.mkdir()
         shutil.copy(src / "LCV.py", proj / "LCV.py")
-        cfg = {"mode": "presets"} if itf.preset_mode else {"mode": "vehicle", "vehicle_file": "vehicle.toml"}
+        cfg = {"mode": "presets"} if itf.preset_mode else {
+            "mode": "vehicle", "vehicle_file": "vehicle.toml",
+            "u_start_mps": next(v.start for v in itf.variables if v.name == "u")}
         (proj / "lcv_fmu.json").write_text(json.dumps(cfg), encoding="utf-8")
         extra = [proj / "lcv_fmu.json"]
         if not itf.preset_mode:
@@ -369,7 +371,8 @@ def build_preset_fmus(out_dir: Path) -> list[Path]:
     return [build_python_fmu(itf, out_dir, "LCV"), build_native_fmu(itf, out_dir, "LCVNative")]
 
 
-def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both") -> list[Path]:
+def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both",
+                       u_start_mps: float = U_START) -> list[Path]:
     """``<name>.fmu`` (pythonfmu) and/or ``<name>Native.fmu`` (C99) of a vehicle (SPEC section 9).
 
     Parameters
@@ -377,10 +380,12 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
     vehicle : Vehicle
     out_dir : path
     kind : {"python", "native", "both"}
+    u_start_mps : float
+        Start value of the input ``u`` [m/s] (default 50 mph).
     """
     if kind not in ("python", "native", "both"):
         raise ValueError(f"kind must be python, native or both, got {kind!r}")
-    itf = vehicle_interface(vehicle)
+    itf = vehicle_interface(vehicle, u_start_mps)
     out = []
     if kind in ("python", "both"):
         out.append(build_python_fmu(itf, Path(out_dir), vehicle.name))

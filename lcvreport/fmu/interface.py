@@ -184,8 +184,8 @@ def _parameters(t: _Table) -> None:
           f"(one warning), in {RANGES['u_min'].text()}", ("parameter", "u_min"), range_key="u_min")
 
 
-def _speed_and_steer(t: _Table, steer_text: str) -> None:
-    t.add("u", "input", "continuous", "speed", U_START,
+def _speed_and_steer(t: _Table, steer_text: str, u_start: float = U_START) -> None:
+    t.add("u", "input", "continuous", "speed", u_start,
           f"Forward speed of every unit, held over each communication step; at most {RANGES['speed'].high:g} m/s",
           ("speed",))
     t.add("delta", "input", "continuous", "angle", 0.0,
@@ -242,13 +242,15 @@ def preset_interface() -> Interface:
                      "zero-order-hold stepping for any communication step size.")
 
 
-def vehicle_interface(vehicle: Vehicle) -> Interface:
-    """The SPEC section 9 interface of an FMU with ``vehicle`` built in."""
+def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START) -> Interface:
+    """The SPEC section 9 interface of an FMU with ``vehicle`` built in; the input ``u``
+    starts at ``u_start_mps`` [m/s] (default 50 mph)."""
+    RANGES["speed"].check(u_start_mps, "start speed")
     t = _Table("si")
     _parameters(t)
     steered = vehicle.steered_axles
     steer_text = ("axles " + ", ".join(a.name for a in steered)) if steered else "no axle (none is steered)"
-    _speed_and_steer(t, steer_text)
+    _speed_and_steer(t, steer_text, float(u_start_mps))
     for i, u in enumerate(vehicle.units):
         for a in u.axles:
             t.add(f"P_{a.name}", "input", "continuous", "force", 0.0, f"Residual lateral force (conicity, ply steer) "

@@ -24,7 +24,7 @@ from pythonfmu.enums import Fmi2Status
 
 from lcvreport.fmu.engine import CosimError, LCVEngine, state_from_bytes, state_to_bytes
 from lcvreport.fmu.model_description import model_description
-from lcvreport.fmu.interface import preset_interface, vehicle_interface
+from lcvreport.fmu.interface import U_START, preset_interface, vehicle_interface
 from lcvreport.model.vehicle_file import load_vehicle
 
 
@@ -34,7 +34,8 @@ def _interface(resources: str):
         cfg = json.load(f)
     if cfg["mode"] == "presets":
         return preset_interface()
-    return vehicle_interface(load_vehicle(os.path.join(resources, cfg["vehicle_file"])))
+    return vehicle_interface(load_vehicle(os.path.join(resources, cfg["vehicle_file"])),
+                             cfg.get("u_start_mps", U_START))
 
 
 _CAUSALITY = {"parameter": Fmi2Causality.parameter, "input": Fmi2Causality.input, "output": Fmi2Causality.output}

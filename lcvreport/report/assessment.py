@@ -45,11 +45,12 @@ class Assessment:
 
     @classmethod
     def load(cls, preset: str | None = None, vehicle_file: str | None = None, speed_kph: float = 88.0,
-             load_units=None, fast: bool = False) -> "Assessment":
-        """From a preset name or a vehicle file."""
+             load_units=None, fast: bool = False, source: str | None = None) -> "Assessment":
+        """From a preset name or a vehicle file; ``source`` names it for captions (default:
+        the preset or the file's path)."""
         vehicle = load_preset(preset) if preset is not None else load_vehicle(vehicle_file)
         return cls(vehicle, float(speed_kph), tuple(load_units or ()), fast,
-                   f"preset {preset}" if preset is not None else str(vehicle_file))
+                   source or (f"preset {preset}" if preset is not None else str(vehicle_file)))
 
     @property
     def speed_mps(self) -> float:
@@ -62,7 +63,21 @@ class Assessment:
 
     # ------------------------------------------------------------------ data
     def fig_vehicle(self):
-        return plotting.fig_vehicle(self.vehicle, f"{self.vehicle.name}: {self.vehicle.n_units} units")
+        fig = plotting.fig_vehicle(self.vehicle, f"{self.vehicle.name}: {self.vehicle.n_units} units")
+        poses = plotting.unit_poses(self.vehicle)
+        rows = []
+        for k, ((cg, _psi), u) in enumerate(zip(poses, self.vehicle.units)):
+            front, rear, half = plotting.body_extent(self.vehicle, k)
+            rows.append({"unit": u.name, "item": "CG", "x_m": cg[0], "half_width_m": ""})
+            rows.append({"unit": u.name, "item": "drawn body front", "x_m": cg[0] + front, "half_width_m": half})
+            rows.append({"unit": u.name, "item": "drawn body rear", "x_m": cg[0] + rear, "half_width_m": half})
+            for name, x in (("front coupling", u.front_coupling_m), ("rear coupling", u.rear_coupling_m)):
+                if x is not None:
+                    rows.append({"unit": u.name, "item": name, "x_m": cg[0] + x, "half_width_m": ""})
+            for a in u.axles:
+                rows.append({"unit": u.name, "item": f"axle {a.name}", "x_m": cg[0] + a.x_m, "half_width_m": ""})
+        fig.lcv_data = rows      # x from the first unit's CG, straight running
+        return fig
 
     def unit_rows(self) -> list[dict]:
         """Units: mass, inertia, couplings, rear end (SI)."""
@@ -98,7 +113,13 @@ class Assessment:
         return [int(i) for i in idx[np.argsort(m.damping_ratio[idx])][:count]]
 
     def fig_mode(self, index: int):
-        return plotting.fig_mode_shape(self.vehicle, self.modes, index, f"Mode {index + 1}")
+        fig = plotting.fig_mode_shape(self.vehicle, self.modes, index, f"Mode {index + 1}")
+        lam = self.modes.eigenvalues[index]
+        fig.lcv_data = [{"state": name, "eigenvalue_real_per_s": lam.real, "eigenvalue_imag_per_s": lam.imag,
+                         "shape_real": x.real, "shape_imag": x.imag, "shape_magnitude": abs(x),
+                         "shape_phase_deg": float(np.degrees(np.angle(x)))}
+                        for name, x in zip(self.modes.state_names, self.modes.shapes[:, index])]
+        return fig
 
     # ------------------------------------------------------------------ stability over speed
     @cached_property
@@ -107,14 +128,22 @@ class Assessment:
         return measures.speed_sweep(self.vehicle, np.linspace(lo, hi, 25 if self.fast else 121))
 
     def fig_root_locus(self):
-        return plotting.fig_root_locus(self.sweep.speeds_kph, self.sweep.eigenvalues,
-                                       f"Root locus of {self.vehicle.name}, {SWEEP_KPH[0]:g}-{SWEEP_KPH[1]:g} km/h",
-                                       self.sweep.critical_speed_kph)
+        fig = plotting.fig_root_locus(self.sweep.speeds_kph, self.sweep.eigenvalues,
+                                      f"Root locus of {self.vehicle.name}, {SWEEP_KPH[0]:g}-{SWEEP_KPH[1]:g} km/h",
+                                      self.sweep.critical_speed_kph)
+        fig.lcv_data = [{"speed_kph": v, "mode": j + 1, "real_per_s": lam.real, "imag_per_s": lam.imag}
+                        for v, row in zip(self.sweep.speeds_kph, self.sweep.eigenvalues)
+                        for j, lam in enumerate(row)]
+        return fig
 
     def fig_damping(self):
-        return plotting.fig_damping_over_speed(self.sweep.speeds_kph, self.sweep.least_damping_ratio,
-                                               self.sweep.max_real, self.vehicle.name, self.sweep.critical_speed_kph,
-                                               self.speed_kph)
+        fig = plotting.fig_damping_over_speed(self.sweep.speeds_kph, self.sweep.least_damping_ratio,
+                                              self.sweep.max_real, self.vehicle.name, self.sweep.critical_speed_kph,
+                                              self.speed_kph)
+        fig.lcv_data = [{"speed_kph": v, "least_damping_ratio": z, "max_real_per_s": m}
+                        for v, z, m in zip(self.sweep.speeds_kph, self.sweep.least_damping_ratio,
+                                           self.sweep.max_real)]
+        return fig
 
     # ------------------------------------------------------------------ rearward amplification
     @cached_property
@@ -125,16 +154,29 @@ class Assessment:
         f = self.frequencies_hz
         G = np.abs(measures.steer_to_acceleration(self.vehicle, self.speed_mps, f))
         curves = [(f"RA = |G_{self.vehicle.n_units}| / |G_1|", G[:, -1] / G[:, 0])]
-        return plotting.fig_frequency(f, curves, "rearward amplification [-]",
-                                      f"Rearward amplification of {self.at}", measures.RA_FREQUENCY_HZ)
+        fig = plotting.fig_frequency(f, curves, "rearward amplification [-]",
+                                     f"Rearward amplification of {self.at}", measures.RA_FREQUENCY_HZ)
+        fig.lcv_data = [{"frequency_hz": fi, "rearward_amplification": ra} for fi, ra in zip(f, G[:, -1] / G[:, 0])]
+        return fig
 
     def fig_gains(self):
         f = self.frequencies_hz
         G = np.abs(measures.steer_to_acceleration(self.vehicle, self.speed_mps, f))
         curves = [(f"|G_{i + 1}| {name}", G[:, i]) for i, name in enumerate(self.vehicle.unit_names)]
-        return plotting.fig_frequency(f, curves, "lateral acceleration per steer angle [m/s²/rad]",
-                                      f"Steer-to-lateral-acceleration gains of {self.at}", measures.RA_FREQUENCY_HZ,
-                                      logy=True)
+        fig = plotting.fig_frequency(f, curves, "lateral acceleration per steer angle [m/s²/rad]",
+                                     f"Steer-to-lateral-acceleration gains of {self.at}", measures.RA_FREQUENCY_HZ,
+                                     logy=True)
+        fig.lcv_data = [{"frequency_hz": fi, **{f"gain_{name}_m_per_s2_per_rad": g for name, g in
+                                                zip(self.vehicle.unit_names, row)}} for fi, row in zip(f, G)]
+        return fig
+
+    def fig_single_sine(self):
+        ss = self.single_sine
+        fig = ss.plot()
+        fig.lcv_data = [{"time_s": t, "steer_angle_rad": d, **{f"ay_{name}_m_per_s2": a for name, a in
+                                                                zip(self.vehicle.unit_names, row)}}
+                        for t, d, row in zip(ss.time, ss.delta, ss.ay)]
+        return fig
 
     @cached_property
     def single_sine(self) -> measures.SingleSine:
@@ -159,12 +201,40 @@ class Assessment:
 
     def fig_sensitivity(self):
         rows = self.sensitivity
-        return plotting.fig_bars([f"{s.axle} ({s.unit})" for s in rows],
+        fig = plotting.fig_bars([f"{s.axle} ({s.unit})" for s in rows],
                                  [("per kN of P", np.array([1e3 * s.offtracking_per_P_m_per_kN for s in rows])),
                                   ("per kN·m of T", np.array([1e3 * s.offtracking_per_T_m_per_kNm for s in rows]))],
                                  "trimmed offtracking [mm]", f"Conicity sensitivity of {self.at}, ranked",
-                                 height=1.2 + 0.32 * len(rows), horizontal=True)
+                                height=1.2 + 0.32 * len(rows), horizontal=True)
+        fig.lcv_data = self.sensitivity_rows()
+        return fig
+
+    # ------------------------------------------------------------------ summary
+    no_steer_note = ("*Not computed: the vehicle has no steered axle, so there is no steer input to respond to "
+                     "(rearward amplification, gains, single sine) or to trim with (conicity sensitivity).*")
+
+    def summary_markdown(self) -> str:
+        """The first page's summary: the vehicle's description and the headline measures."""
+        m = self.measures
+        lines = []
+        if self.vehicle.description:
+            lines += [f"*{self.vehicle.name}*: {self.vehicle.description}", ""]
+        lines += [f"At {self.speed_kph:g} km/h ({self.source}):", ""]
+        zeta = "no oscillatory mode" if m.least_damping_ratio is None else \
+            f"{m.least_damping_ratio:.3f} at {m.least_damped_frequency_hz:.3f} Hz"
+        lines.append(f"- least damping ratio: {zeta}")
+        lines.append("- critical speed: " + ("none, stable up to 200 km/h" if m.critical_speed_kph is None
+                                             else f"{m.critical_speed_kph:.1f} km/h"))
+        if m.ra_frequency is None:
+            lines.append("- rearward amplification: not computed (no steered axle)")
+        else:
+            lines.append(f"- rearward amplification at {m.f_hz:g} Hz: {m.ra_frequency:.3f} (frequency domain), "
+                         f"{m.ra_single_sine:.3f} (single sine)")
+        if m.trim is not None:
+            lines.append(f"- trimmed offtracking under the 1 % rule on {', '.join(self.load_units)}: "
+                         f"{1e3 * m.trim.offtracking_m:.1f} mm (trim steer {1e3 * m.trim.delta_rad:.3f} mrad)")
+        return "\n".join(lines)
 
     # ------------------------------------------------------------------ FMU
     def interface_rows(self) -> list[dict]:
-        return vehicle_interface(self.vehicle).rows()
+        return vehicle_interface(self.vehicle, self.speed_mps).rows()

@@ -111,6 +111,11 @@ def _load_units(name, value, ctx):
                           f"got {value!r}")
 
 
+def _text_or_none(name, value, _ctx):
+    if value is not None and not isinstance(value, str):
+        raise ReportError(f"parameter {name} must be text or None, got {value!r}")
+
+
 def _vehicle_file(name, value, _ctx):
     if value is not None and not isinstance(value, str):
         raise ReportError(f"parameter {name} must be the path of a vehicle file or None, got {value!r}")
@@ -144,6 +149,7 @@ NOTEBOOKS = (
 #: the assessment report's notebook
 ASSESSMENT = NotebookSpec("assessment", "assessment", "Yaw-plane assessment",
                           {**_COMMON, "preset": lambda n, v, c: None, "vehicle_file": _vehicle_file,
+                           "source": _text_or_none,
                            "speed_kph": _speed(1 / MPS_PER_KPH, "km/h"), "load_units": _load_units})
 SPECS = {s.stem: s for s in NOTEBOOKS + (ASSESSMENT,)}
 
@@ -288,7 +294,7 @@ def export_html(nb, out_dir: Path) -> Path:
     return path
 
 
-def export_pdf(nb, out_dir: Path, author: str, paper: str = "letter") -> Path:
+def export_pdf(nb, out_dir: Path, author: str, paper: str = "letter", title_page: bool = True) -> Path:
     """PDF through nbconvert's LaTeX route (xelatex) with the lcvlatex template; the LaTeX
     log of the last run is kept as ``latex.log`` beside it (see :func:`overfull_boxes`)."""
     from nbconvert import PDFExporter
@@ -307,7 +313,7 @@ def export_pdf(nb, out_dir: Path, author: str, paper: str = "letter") -> Path:
     exporter.latex_command = ["xelatex", "-interaction=batchmode", "-halt-on-error", "{filename}"]
     try:
         pdf, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": "report"}, "lcv_author": author,
-                                                              "lcv_paper": paper})
+                                                              "lcv_paper": paper, "lcv_title_page": title_page})
     except Exception as exc:  # nbconvert raises LatexFailed with the log
         raise ReportError(f"PDF export (xelatex) failed: {str(exc)[-2000:]}") from None
     path = out_dir / "report.pdf"
@@ -547,7 +553,8 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
             dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name}).")
         vehicle_file.write_text(text, encoding="utf-8")
         params = {"fast": bool(fast), "data_dir": str(data_dir), "preset": None, "vehicle_file": str(vehicle_file),
-                  "speed_kph": float(speed_kph), "load_units": list(load_units) if load_units else None}
+                  "source": source or None, "speed_kph": float(speed_kph),
+                  "load_units": list(load_units) if load_units else None}
         t0 = time.perf_counter()
         nb_dir = staged / "notebooks"
         nb_dir.mkdir()
@@ -555,16 +562,16 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         progress(f"notebook assessment: {time.perf_counter() - t0:.1f} s")
         title = f"Yaw-plane assessment of {vehicle.name} at {speed_kph:g} km/h"
         stamp = time.strftime("%Y-%m-%d", time.gmtime(int(os.environ.get("SOURCE_DATE_EPOCH", time.time()))))
-        description = f"\n\n> {vehicle.description}" if vehicle.description else ""
         intro = (f"Linear yaw-plane model of *{vehicle.name}* ({vehicle.n_units} units: "
                  f"{', '.join(vehicle.unit_names)}){' from ' + source if source else ''}, assessed at {speed_kph:g} km/h "
-                 f"(SI units; speeds in km/h). Written by lcvreport {__version__} on {stamp}.{description}")
+                 f"(SI units; speeds in km/h). Written by lcvreport {__version__} on {stamp}.")
         nb = merge([("assessment", "assessment", title, path)], title, intro)
         html = export_html(nb, staged)
         progress("html written")
         written = {"html": "index.html", "data": "data"}
         if pdf:
-            export_pdf(nb, staged, f"lcvreport {__version__} assessment of {vehicle.name}", paper=paper)
+            export_pdf(nb, staged, f"lcvreport {__version__} assessment of {vehicle.name}", paper=paper,
+                       title_page=False)
             written["pdf"] = "report.pdf"
             progress("pdf written")
         files = sorted(p.name for p in staged.iterdir()) + [MANIFEST]

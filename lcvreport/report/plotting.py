@@ -110,8 +110,11 @@ def draw_unit(ax, vehicle: Vehicle, k: int, cg: np.ndarray, psi: float, alpha: f
     u = vehicle.units[k]
     kind = unit_kind(vehicle, k)
     front, rear, hw = body_extent(vehicle, k)
+    # bodies under everything; a dolly's frame above the trailer body that covers it; every
+    # axle above all bodies (a tractor's drive axles sit under the semitrailer's front)
     ax.add_patch(Polygon(f * _rect(cg, psi, front, rear, hw), closed=True, alpha=alpha,
-                         facecolor="none" if outline_only else BODY[kind], edgecolor="black", lw=0.8))
+                         facecolor="none" if outline_only else BODY[kind], edgecolor="black", lw=0.8,
+                         zorder=1.6 if kind == "dolly" else 1.0))
     if tires:
         nrm = np.array([-np.sin(psi), np.cos(psi)])
         for a in u.axles:
@@ -123,11 +126,11 @@ def draw_unit(ax, vehicle: Vehicle, k: int, cg: np.ndarray, psi: float, alpha: f
             for side in (1, -1):
                 for o in offs:
                     ax.add_patch(Polygon(f * _rect(centre + side * o * nrm, psi, 0.5, -0.5, 0.11), closed=True,
-                                         facecolor="black", alpha=alpha, lw=0))
+                                         facecolor="black", alpha=alpha, lw=0, zorder=2.5))
             a_end = centre + (TRACK_WIDTH_M / 2 + D) * nrm
             b_end = centre - (TRACK_WIDTH_M / 2 + D) * nrm
             ax.plot(f * np.array([a_end[0], b_end[0]]), f * np.array([a_end[1], b_end[1]]), color="black",
-                    lw=0.8, alpha=alpha)
+                    lw=0.8, alpha=alpha, zorder=2.5)
     if k > 0:
         j = f * (cg + u.front_coupling_m * _dir(psi))
         ax.plot(j[0], j[1], "o", ms=4, color="white", mec="black", alpha=alpha, zorder=5)
@@ -177,13 +180,14 @@ def fig_combinations(vehicles: list[tuple[str, Vehicle]], unit: str = "m") -> Fi
 def fig_vehicle(vehicle: Vehicle, title: str) -> Figure:
     """The vehicle to scale from its file, with the couplings, axles and CGs marked [m]."""
     poses = unit_poses(vehicle)
-    length = -min(cg[0] + body_extent(vehicle, k)[1] for k, (cg, _p) in enumerate(poses))
+    ends = [(cg[0] + body_extent(vehicle, k)[0], cg[0] + body_extent(vehicle, k)[1]) for k, (cg, _p) in enumerate(poses)]
+    length = max(e[0] for e in ends) - min(e[1] for e in ends)      # tractor front to rearmost body end
     fig, ax = new_figure(PAGE_WIDTH_IN, 2.4)
     draw_vehicle(ax, vehicle)
     for k, (cg, _psi) in enumerate(poses):
         ax.plot(cg[0], cg[1], "+", color="red", ms=5, mew=0.8, zorder=6)
-    ax.set_title(f"{title} (to scale; + CG, o coupling; overall about {length + FRONT_OVERHANG_M:.1f} m)",
-                 fontsize=8)
+    ax.set_title(f"{title} (to scale; + CG, o coupling; overall about {length:.1f} m with the cab front "
+                 f"{FRONT_OVERHANG_M:g} m ahead of the steer axle, assumed)", fontsize=8)
     _top_view_axes(ax, "m", ylim_m=2.6)
     return fig
 
@@ -363,6 +367,18 @@ def fig_root_locus(speeds_kph: np.ndarray, eigenvalues: np.ndarray, title: str,
     cb.ax.tick_params(labelsize=SMALL_PT)
     ax.axvline(0, color="black", lw=0.8)
     ax.axhline(0, color="black", lw=0.5)
+    # zoom to the oscillatory modes: far-left real poles (fast, well damped) would squeeze them
+    osc = np.abs(eigenvalues.imag) > 1e-9 * np.abs(eigenvalues).max()
+    if osc.any():
+        left = 1.15 * min(eigenvalues.real[osc].min(), 0.0) - 0.05
+        right = max(0.1 * abs(left), 1.15 * eigenvalues.real.max())
+        hidden = int(np.sum(eigenvalues.real.min(axis=0) < left))
+        ax.set_xlim(left, right)
+        top = 1.1 * np.abs(eigenvalues.imag[osc]).max()
+        ax.set_ylim(-top, top)
+        if hidden:
+            ax.text(0.01, 0.02, f"{hidden} real mode(s) left of the frame (faster, Re < {left:.3g} 1/s; in the CSV)",
+                    transform=ax.transAxes, fontsize=SMALL_PT, ha="left", va="bottom")
     note = "stable throughout" if critical_kph is None else f"critical speed {critical_kph:.1f} km/h"
     ax.set_xlabel("Re(lambda) [1/s]")
     ax.set_ylabel("Im(lambda) [1/s]")
@@ -493,7 +509,9 @@ def plot_single_sine(ss, ax=None) -> Figure:
     ax.set_xlabel("time [s]")
     ax.set_ylabel("lateral acceleration [m/s²]")
     ax.grid(True, lw=0.3)
-    ax.legend(fontsize=SMALL_PT, ncol=2, loc="lower right")
+    # below the axes: inside, it covered the peaks RA is computed from
+    ax.legend(handles=ax.get_lines() + ax2.get_lines(), fontsize=SMALL_PT, ncol=3, loc="upper center",
+              bbox_to_anchor=(0.5, -0.18), frameon=False)
     return fig
 
 

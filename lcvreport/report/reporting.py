@@ -99,7 +99,8 @@ def _slug(number: str) -> str:
 
 
 def write_csv(path: Path, rows: list[dict]) -> None:
-    """Write ``rows`` (dicts with the same keys) as CSV; floats with repr (exact)."""
+    """Write ``rows`` (dicts with the same keys) as CSV; floats with repr (exact), an
+    undefined number (NaN) as an empty cell."""
     if not rows:
         path.write_text("")
         return
@@ -107,7 +108,7 @@ def write_csv(path: Path, rows: list[dict]) -> None:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()), lineterminator="\n")
         w.writeheader()
         for r in rows:
-            w.writerow({k: repr(float(v)) if isinstance(v, (float, np.floating)) else
+            w.writerow({k: ("" if np.isnan(v) else repr(float(v))) if isinstance(v, (float, np.floating)) else
                         repr(complex(v)) if isinstance(v, (complex, np.complexfloating)) else v
                         for k, v in r.items()})
 
@@ -240,7 +241,7 @@ class Table:
         breaks), text in ragged paragraph columns, headers broken between words, the
         caption above; one block up to :data:`UNBROKEN_HEIGHT_PT`, else a longtable;
         on a landscape page when the columns need it."""
-        cap = rf"\textbf{{Table {_latex_escape(self.number)}.}} {_latex_escape(self.caption)}"
+        cap = rf"\textbf{{Table {_latex_escape(self.number)}.}} {_code_spans(self.caption, _latex_escape, 'latex')}"
         if not self.headers:
             return cap + " (no rows)"
         widths, landscape, size, gap = self._layout()
@@ -282,7 +283,7 @@ class Table:
         body = "".join("<tr>" + "".join(f'<td style="text-align:{a}">{html.escape(c)}</td>'
                                         for c, a in zip(row, align)) + "</tr>" for row in self.cells)
         return (f'<table class="lcv-table"><caption style="caption-side:top;text-align:left">'
-                f"<b>Table {html.escape(self.number)}.</b> {html.escape(self.caption)}</caption>"
+                f"<b>Table {html.escape(self.number)}.</b> {_code_spans(self.caption, html.escape, 'html')}</caption>"
                 f"<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
 
     def _repr_markdown_(self) -> str:
@@ -293,11 +294,33 @@ class Table:
         return "\n".join(lines)
 
 
+def _code_spans(text: str, escape, target: str) -> str:
+    """``text`` escaped for ``target`` ("latex" or "html"), its `code spans` set as code
+    (Markdown captions may name commands such as `lcv measures`)."""
+    parts = text.split("`")
+    if len(parts) % 2 == 0:            # an unpaired backtick: plain text
+        return escape(text)
+    out = []
+    for i, part in enumerate(parts):
+        if i % 2 == 0:
+            out.append(escape(part))
+        elif target == "latex":
+            out.append(r"\texttt{" + escape(part) + "}")
+        else:
+            out.append("<code>" + escape(part) + "</code>")
+    return "".join(out)
+
+
 def show_figure(fig, number: str, caption: str, data_dir: str | Path | None) -> None:
-    """Display ``fig`` with the caption ``Figure <number>. <caption>`` and save its data as CSV."""
+    """Display ``fig`` with the caption ``Figure <number>. <caption>`` and save its data as CSV.
+
+    The CSV holds the engineering data behind the figure when the code that drew it
+    attached them (``fig.lcv_data``: rows with units in the column names), else the
+    points of every line, marker set, bar and polygon (:func:`figure_data`)."""
     from IPython.display import Markdown, display
     if data_dir is not None:
-        write_csv(Path(data_dir) / f"figure_{_slug(number)}.csv", figure_data(fig))
+        rows = getattr(fig, "lcv_data", None)
+        write_csv(Path(data_dir) / f"figure_{_slug(number)}.csv", rows if rows is not None else figure_data(fig))
     display(fig)
     display(Markdown(f"**Figure {number}.** {caption}"))
 
