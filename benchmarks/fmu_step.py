@@ -3,14 +3,18 @@
 A 10 s run at 1 ms steps (10,000 steps) recording every output under
 ``fmpy.simulate_fmu``, for
 
-* ``LCV.fmu`` (pythonfmu) and its interface-only twin: the same FMU whose slave class
-  does nothing in ``do_step`` and returns zeros -- pythonfmu's own per-step cost;
+* ``LCV.fmu`` (pythonfmu) and two twins: a **stock pythonfmu FMU** with the same 45
+  variables (a plain ``Fmi2Slave`` written here, built by ``pythonfmu build``, no loader,
+  no guards: what any pythonfmu FMU of this interface costs -- the code under test cannot
+  influence it), and the interface-only twin (LCV's own slave and loader machinery with no
+  model: what the guards cost);
 * ``LCVNative.fmu`` (C) and its interface-only twin built from the same interface table
   with ``fmu_src/c/model_stub.c`` (``build_native_fmu(..., stub=True)``);
 * ``LCVNative.fmu`` in the plain C host of ``tests/c_host.c`` (10^6 steps).
 
-Runs are alternated and the best of ``REPEATS`` is kept.  Targets: LCV / its twin <= 1.5
-(the model costs less than pythonfmu's own machinery); LCVNative's model cost below
+Runs are alternated and the best of ``REPEATS`` is kept.  Targets: LCV / the stock
+pythonfmu twin <= 1.5 (the guards and the model together cost less than half of what
+pythonfmu itself costs per step); LCVNative's model cost below
 fmpy's per-step floor (its twin) and < 1 us/step in the C host.  The speed-up of
 LCVNative over LCV under fmpy is printed too; it is bounded by fmpy's own per-step cost,
 which the C twin measures.
@@ -50,6 +54,33 @@ ctypes.c_ssize_t.from_address(id(globals())).value += 1   # as fmu_src/LCV.py: p
 '''
 
 
+def stock_slave_source() -> str:
+    """A plain pythonfmu slave with the preset FMU's variables (names, causality,
+    variability, start values), nothing computed: written from the interface table's
+    names only, with pythonfmu's stock getters and setters."""
+    from lcvreport.fmu.interface import preset_interface
+    lines = ["from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real, String", "",
+             "", "class LCV(Fmi2Slave):", "    def __init__(self, **kwargs):", "        super().__init__(**kwargs)"]
+    for v in preset_interface().variables:
+        kind = "String" if v.type == "String" else "Real"
+        start = repr(v.start) if v.start is not None else "0.0"
+        lines.append(f"        self.{v.name} = {start}")
+        lines.append(f"        self.register_variable({kind}({v.name!r}, causality=Fmi2Causality.{v.causality}, "
+                     f"variability=Fmi2Variability.{v.variability}))")
+    lines += ["", "    def do_step(self, current_time, step_size):", "        return True", ""]
+    return "\n".join(lines)
+
+
+def build_stock_twin(out_dir: Path) -> Path:
+    """The stock pythonfmu FMU of :func:`stock_slave_source`, built by ``pythonfmu build``."""
+    src = out_dir / "src"
+    src.mkdir(parents=True)
+    (src / "LCV.py").write_text(stock_slave_source(), encoding="utf-8")
+    subprocess.run([sys.executable, "-m", "pythonfmu", "build", "-f", str(src / "LCV.py"), "-d", str(out_dir)],
+                   check=True, capture_output=True, cwd=out_dir)
+    return out_dir / "LCV.fmu"
+
+
 def build_python_twin(lcv: Path, out_dir: Path) -> Path:
     """LCV.fmu with its slave module replaced by :data:`TWIN_SLAVE`."""
     twin = out_dir / "LCV.fmu"
@@ -66,11 +97,16 @@ def build_native_twin(out_dir: Path) -> Path:
 
 
 def time_fmpy(fmu: Path, outputs: list[str]) -> float:
-    from fmpy import simulate_fmu
-    t0 = time.perf_counter()
-    simulate_fmu(str(fmu), stop_time=STOP, step_size=STEP, output_interval=STEP, output=outputs,
-                 start_values={"preset": "aucnat"})
-    return time.perf_counter() - t0
+    """Seconds of one ``simulate_fmu`` run, timed in a fresh process: pythonfmu imports the
+    slave module by its name (``LCV`` for all three Python FMUs here), so two of them in
+    one process would share the first one's class and time the same code twice."""
+    code = ("import sys, time\nfrom fmpy import simulate_fmu\n"
+            f"args = dict(stop_time={STOP!r}, step_size={STEP!r}, output_interval={STEP!r}, output={outputs!r}, "
+            "start_values={'preset': 'aucnat'})\n"
+            "simulate_fmu(sys.argv[1], stop_time=0.01, step_size=0.001, start_values={'preset': 'aucnat'})\n"
+            "t0 = time.perf_counter()\nsimulate_fmu(sys.argv[1], **args)\nprint(time.perf_counter() - t0)\n")
+    p = subprocess.run([sys.executable, "-c", code, str(fmu)], capture_output=True, text=True, check=True)
+    return float(p.stdout.split()[-1])
 
 
 def c_host_us_per_step(fmu: Path) -> float:
@@ -103,11 +139,10 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "py").mkdir()
         (Path(tmp) / "c").mkdir()
-        paths = {"LCV.fmu": lcv, "LCV twin (interface only)": build_python_twin(lcv, Path(tmp) / "py"),
+        paths = {"LCV.fmu": lcv, "stock pythonfmu twin": build_stock_twin(Path(tmp) / "stock"),
+                 "LCV twin (interface only)": build_python_twin(lcv, Path(tmp) / "py"),
                  "LCVNative.fmu": native, "C twin (interface only)": build_native_twin(Path(tmp) / "c")}
         runs: dict[str, list[float]] = {k: [] for k in paths}
-        for name, path in paths.items():
-            time_fmpy(path, outputs)                      # warm up (unzip, imports)
         for _ in range(REPEATS):
             for name, path in paths.items():
                 runs[name].append(time_fmpy(path, outputs))
@@ -116,7 +151,10 @@ def main() -> None:
           f"best of {REPEATS}:")
     for k, v in us.items():
         print(f"  {k:28s} {v:8.2f} us/step")
-    print(f"  LCV / its twin                   {us['LCV.fmu'] / us['LCV twin (interface only)']:6.2f}   (target <= 1.5)")
+    print(f"  LCV / stock pythonfmu twin       {us['LCV.fmu'] / us['stock pythonfmu twin']:6.2f}   (target <= 1.5)")
+    print(f"  LCV / its interface-only twin    {us['LCV.fmu'] / us['LCV twin (interface only)']:6.2f}")
+    print(f"  guards (interface-only twin - stock) "
+          f"{us['LCV twin (interface only)'] - us['stock pythonfmu twin']:6.2f} us/step")
     print(f"  model cost in LCV.fmu            {us['LCV.fmu'] - us['LCV twin (interface only)']:6.2f} us/step")
     print(f"  model cost in LCVNative.fmu      {us['LCVNative.fmu'] - us['C twin (interface only)']:6.2f} us/step")
     print(f"  speed-up LCVNative vs LCV        {us['LCV.fmu'] / us['LCVNative.fmu']:6.1f}x   "

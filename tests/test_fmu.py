@@ -311,3 +311,31 @@ def test_ecos_command_line_runner_with_an_ssp(native_fmu, tmp_path):
         np.testing.assert_allclose(data[f"truck::{name}[REAL]"][keep], ref[k[keep] - 1, names.index(name)],
                                    rtol=0, atol=6e-7)
     assert abs(ref[-1, names.index("y2")]) > 1e-3          # a real response, not zeros
+
+
+def test_outputs_read_after_new_inputs_without_a_step_use_the_new_inputs(preset_fmu):
+    """The values of a step are kept until the inputs change (guards once per call): a
+    get after a set, with no step between, must see the new inputs (ay feeds the steer and
+    the residual forces through; max_real_eig follows u)."""
+    s = Slave(preset_fmu, preset="aucnat").init()
+    s.set(delta=0.01, P61=500.0)
+    s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.3)
+    before = s.get()
+    s.set(delta=-0.02, P41=-800.0, u=15.0)
+    after = s.get()
+    s.free()
+    v = load_preset("aucnat")
+    co = system_coefficients(v)
+    eng = LCVEngine(ITF, "aucnat")
+    Bw = eng.maps()["Bw"]
+    names = s.outputs
+    x = np.array([before[names.index(n)] for n in v.state_names])
+    np.testing.assert_array_equal([after[names.index(n)] for n in v.state_names], x)   # the state has not moved
+    w = eng.start_inputs()
+    for name, value in (("delta", -0.02), ("P61", 500.0), ("P41", -800.0), ("u", 15.0)):
+        w[eng.input_index[name]] = value
+    Ca, Da = co.acceleration_maps(15.0)
+    ay = Ca @ x + Da @ (Bw @ w)
+    got = np.array([after[names.index(f"ay{i}")] for i in range(1, 7)])
+    np.testing.assert_allclose(got, ay, rtol=1e-9, atol=1e-12 * np.abs(ay).max())
+    assert after[names.index("max_real_eig")] == pytest.approx(eigenvalues(v, 15.0).real.max(), rel=1e-12)

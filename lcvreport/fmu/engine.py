@@ -102,6 +102,12 @@ class LCVEngine:
         self._build_maps()
         self._steps = LRUCache(cache_size)
         self._speeds = LRUCache(1024)
+        self._steps_out = LRUCache(cache_size)
+        self._zw = np.zeros(self.m + len(self.input_names))
+        self.stepped_outputs = None
+        self._last_h = None
+        self._last_key = None
+        self._last_K = None
         self.reset()
 
     # ------------------------------------------------------------------ set-up
@@ -180,6 +186,7 @@ class LCVEngine:
     def reset(self) -> None:
         """Back to rest at time 0 (keeps the caches)."""
         self.z = np.zeros(self.m)
+        self.stepped_outputs = None
         self.time = 0.0
         self.clamped = False
         self.last_speed_mps = self.effective_speed(float(self.interface.by_name["u"].start))
@@ -232,6 +239,22 @@ class LCVEngine:
             return K
         return self._steps.get((u, h), compute)
 
+    def _step_output_matrix(self, u: float, h: float) -> np.ndarray:
+        """``[K; O P; H K]``: from ``[z, w]`` the new state ``K [z, w]``, the linear
+        outputs at it with ``w`` held (``P [z, w] = [K [z, w], w]``) and the cumulative
+        articulation angles of the rear-end offsets (cached per speed and step)."""
+        def compute():
+            K = self._step_matrix(u, h)
+            nw = len(self.input_names)
+            P = np.vstack([K, np.hstack([np.zeros((nw, self.m)), np.eye(nw)])])
+            rows = [K, self.output_matrix(u) @ P]
+            if self._has_y:
+                rows.append(self._H @ K)
+            out = np.vstack(rows)
+            out.setflags(write=False)
+            return out
+        return self._steps_out.get((u, h), compute)
+
     def _speed_maps(self, u: float) -> dict:
         """Output maps that depend on the speed: ay (Ca, Da Bw); max_real_eig (lazy)."""
         def compute():
@@ -248,8 +271,11 @@ class LCVEngine:
         return maps["eig"]
 
     # ------------------------------------------------------------------ stepping
-    def step(self, h: float, w) -> str | None:
+    def step(self, h: float, w, checked: bool = False) -> str | None:
         """Advance by ``h`` [s] with the SI inputs ``w`` (interface order) held.
+
+        ``checked``: the caller has checked ``w`` with :meth:`input_problem` since it last
+        changed (the FMU slave checks once per change of the inputs, not per step).
 
         Returns
         -------
@@ -262,14 +288,17 @@ class LCVEngine:
             A bad step size or input, or a step whose result is not finite; the state
             is left unchanged.
         """
-        r = RANGES["step_size"]
-        if not (isinstance(h, float) and math.isfinite(h) and r.low <= h <= r.high):
-            raise CosimError("communicationStepSize", f"communication step size must be in {r.text()}, got {h!r}; "
-                                                      "the step is refused")
+        if h != self._last_h:                       # one check per new step size, not per step
+            r = RANGES["step_size"]
+            if not (isinstance(h, float) and math.isfinite(h) and r.low <= h <= r.high):
+                raise CosimError("communicationStepSize", f"communication step size must be in {r.text()}, got "
+                                                          f"{h!r}; the step is refused")
+            self._last_h = h
         w = np.asarray(w, dtype=float)
-        self.check_inputs(w)
+        if not checked:
+            self.check_inputs(w)
         u_in = float(w[0])
-        u = self.effective_speed(u_in)
+        u = u_in if u_in >= self.u_min else self.u_min
         warning = None
         if u_in < self.u_min:
             if not self.clamped:
@@ -278,12 +307,28 @@ class LCVEngine:
             clamped = True
         else:
             clamped = False
-        K = self._step_matrix(u, h)
-        z_new = K[:, :self.m] @ self.z + K[:, self.m:] @ w
-        if not np.all(np.isfinite(z_new)):
+        key = (u, h)
+        if key != self._last_key:
+            self._last_K = self._step_output_matrix(u, h)
+            self._last_key = key
+            self._last_eig = self.max_real_eig(u) if self._eig_out >= 0 else 0.0
+        # one product gives the new state, the outputs at it (inputs held) and the angles
+        # whose sines the rear-end offsets need
+        res = self._last_K @ self.stacked(w)
+        # the sum is finite exactly when every element is (an inf or a NaN propagates), unless
+        # finite elements overflow it, i.e. above 1e307: refused too, as no state can be that large
+        if not math.isfinite(res.sum()):
             raise CosimError("state", f"the step to t = {self.time + h:.6g} s is refused: its result is not finite "
                                       f"(the vehicle is unstable at u = {u:.6g} m/s, max Re(lambda) = "
                                       f"{self.max_real_eig(u):.4g} 1/s); the state is unchanged")
+        m, n_out = self.m, len(self.output_names)
+        z_new = res[:m]
+        out = res[m:m + n_out]
+        if self._has_y:
+            out += self._W @ np.sin(res[m + n_out:])
+        if self._eig_out >= 0:
+            out[self._eig_out] = self._last_eig
+        self.stepped_outputs = out
         self.z = z_new
         self.time += h
         self.clamped = clamped
@@ -299,31 +344,69 @@ class LCVEngine:
             return self.effective_speed(u)
         return self.last_speed_mps
 
-    def outputs(self, w) -> np.ndarray:
+    @property
+    def eig_output(self) -> int:
+        """Index of ``max_real_eig`` among the outputs, -1 if none."""
+        return self._eig_out
+
+    @property
+    def has_y(self) -> bool:
+        """True when some output is a rear-end offset (nonlinear in the state: sines)."""
+        return self._has_y
+
+    def stacked(self, w) -> np.ndarray:
+        """``[z, w]`` in a buffer of the engine (valid until the next call)."""
+        zw = self._zw
+        zw[:self.m] = self.z
+        zw[self.m:] = w
+        return zw
+
+    def rear_offsets(self) -> np.ndarray:
+        """The outputs' rear-end offset terms ``W sin(H z)`` (zero rows elsewhere)."""
+        return self._W @ np.sin(self._H @ self.z)
+
+    def output_matrix(self, u: float) -> np.ndarray:
+        """``O`` with ``outputs = O [z, w] (+ W sin(H z))`` at speed ``u``: the linear
+        outputs and the lateral accelerations in one matrix (cached per speed)."""
+        maps = self._speed_maps(u)
+        O = maps.get("O")
+        if O is None:
+            O = np.hstack([self._C, np.zeros((self._C.shape[0], len(self.input_names)))])
+            sel = np.flatnonzero(self._ay_unit >= 0)
+            if sel.size:
+                O[sel, :self.n] = maps["Ca"][self._ay_unit[sel]]
+                O[sel, self.m:] = maps["DaB"][self._ay_unit[sel]]
+            O.setflags(write=False)
+            maps["O"] = O
+        return O
+
+    def outputs(self, w, problem: CosimError | None | bool = False) -> np.ndarray:
         """Every output (interface order), SI, at the current state and inputs ``w``.
 
         The lateral accelerations depend on the inputs directly: while an input is not
-        finite or out of range they are NaN and :attr:`output_error` says which input."""
+        finite or out of range they are NaN and :attr:`output_error` says which input.
+        ``problem``: the result of :meth:`input_problem(w, speed=False)` when the caller
+        has it (False: check here)."""
         w = np.asarray(w, dtype=float)
         self.output_error = None
-        out = self._C @ self.z
+        if problem is False:
+            problem = self.input_problem(w, speed=False)
+        u = self.output_speed(w)
+        zw = self._zw
+        zw[:self.m] = self.z
+        if problem is None:
+            zw[self.m:] = w
+            out = self.output_matrix(u) @ zw
+        else:
+            out = self._C @ self.z
+            sel = self._ay_unit >= 0
+            out[sel] = np.nan
+            self.output_error = (f"the lateral accelerations depend on the inputs and {problem.variable} is "
+                                 f"not valid: {problem}")
         if self._has_y:
             out += self._W @ np.sin(self._H @ self.z)
-        sel = self._ay_unit >= 0
-        if sel.any() or self._eig_out >= 0:
-            u = self.output_speed(w)
-            if sel.any():
-                problem = self.input_problem(w, speed=False)
-                if problem is None:
-                    maps = self._speed_maps(u)
-                    ay = maps["Ca"] @ self.z[:self.n] + maps["DaB"] @ w
-                    out[sel] = ay[self._ay_unit[sel]]
-                else:
-                    out[sel] = np.nan
-                    self.output_error = (f"the lateral accelerations depend on the inputs and {problem.variable} is "
-                                         f"not valid: {problem}")
-            if self._eig_out >= 0:
-                out[self._eig_out] = self.max_real_eig(u)
+        if self._eig_out >= 0:
+            out[self._eig_out] = self.max_real_eig(u)
         return out
 
     # ------------------------------------------------------------------ FMU state
@@ -352,6 +435,7 @@ class LCVEngine:
         if not (np.all(np.isfinite(z)) and math.isfinite(t) and math.isfinite(last)):
             raise CosimError("FMUstate", "the FMU state holds numbers that are not finite")
         self.z, self.time, self.clamped, self.last_speed_mps = z, t, clamped, last
+        self.stepped_outputs = None
 
 
 def state_to_bytes(state: dict) -> bytes:

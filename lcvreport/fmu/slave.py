@@ -19,6 +19,8 @@ import math
 import os
 import sys
 
+import numpy as np
+
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real, String
 from pythonfmu.enums import Fmi2Status
 
@@ -59,13 +61,31 @@ class LCV(Fmi2Slave):
         self.modelName = self.itf.model_name
         self.description = self.itf.description
         self.params = {v.name: v.start for v in self.itf.parameters}
-        self.inputs = [float(v.start) for v in self.itf.inputs]
+        self.inputs = np.array([float(v.start) for v in self.itf.inputs])
         self.input_slot = {v.value_reference: k for k, v in enumerate(self.itf.inputs)}
         self.output_slot = {v.value_reference: k for k, v in enumerate(self.itf.outputs)}
         self.engine = None
         self.init_error = None
         self.initialized = False
-        self.outputs = [0.0] * len(self.itf.outputs)
+        # per-call guards once, not per value: the inputs are checked once after they change
+        # (``_problem``), every value is computed once per step or change of the inputs and
+        # kept as a list indexed by value reference (``_values``)
+        self._problem = False                 # False: not checked since the inputs changed
+        self._feed_problem = False            # the same for the outputs that feed inputs through (ay)
+        self._values = None
+        self._input_vrs = np.array([v.value_reference for v in self.itf.inputs], dtype=int)
+        self._output_vrs = np.array([v.value_reference for v in self.itf.outputs], dtype=int)
+        self._values_speed = None             # the speed _values_V and _values_c are for
+        # value references: parameters, then the inputs, then the outputs, each in a block
+        n_in, n_out = len(self._input_vrs), len(self._output_vrs)
+        first = int(self._input_vrs[0]) if n_in else len(self.itf.variables)
+        self._contiguous = (self._input_vrs.tolist() == list(range(first, first + n_in)) and
+                            self._output_vrs.tolist() == list(range(first + n_in, first + n_in + n_out)) and
+                            first + n_in + n_out == len(self.itf.variables))
+        self._first_input = first
+        self._bad_vrs = frozenset()
+        self._real_vrs = frozenset(v.value_reference for v in self.itf.variables if v.type == "Real")
+        self._template = self._parameter_values()
         for v in self.itf.variables:  # value reference = registration order = table index
             kw = dict(causality=_CAUSALITY[v.causality], variability=_VARIABILITY[v.variability],
                       description=v.description)
@@ -95,6 +115,8 @@ class LCV(Fmi2Slave):
                                     self.params["u_min"])
             self.init_error = None
             self.initialized = True
+            self._values = None
+            self._values_speed = None
         except CosimError as exc:
             self.engine = None
             self.init_error = str(exc)
@@ -110,7 +132,15 @@ class LCV(Fmi2Slave):
                 self._error(self.init_error and f"{self.init_error}; every doStep will be refused"
                             or "fmi2DoStep called before initialization completed")
                 return False
-            warning = self.engine.step(float(step_size), self.inputs)
+            if self._problem is False:
+                self._problem = self.engine.input_problem(self.inputs)
+            if self._problem is not None:
+                raise self._problem
+            warning = self.engine.step(float(step_size), self.inputs, checked=True)
+            # every value at once: the parameters, the inputs held, the outputs the step gave
+            self._values = (self._prefix + self.inputs.tolist() + self.engine.stepped_outputs.tolist()
+                            if self._contiguous else None)
+            self._bad_vrs = frozenset()
             if warning:
                 self.log(warning, Fmi2Status.warning, "logStatusWarning")
             return True
@@ -125,30 +155,77 @@ class LCV(Fmi2Slave):
         pass
 
     # ---------------------------------------------------------------- values
+    def _parameter_values(self) -> np.ndarray:
+        """Every variable's slot, the Real parameters filled in (the rest filled per call);
+        also ``_prefix``, the slots before the first input as a list."""
+        values = np.zeros(len(self.itf.variables))
+        for v in self.itf.variables:
+            if v.causality == "parameter" and v.type == "Real":
+                values[v.value_reference] = float(self.params[v.name])
+        first = getattr(self, "_first_input", len(values))
+        self._prefix = values[:first].tolist()
+        return values
+
     def get_real(self, vrs):
-        out = [0.0] * len(vrs)
         try:
-            values = None
-            for i, vr in enumerate(vrs):
-                if vr in self.input_slot:
-                    out[i] = float(self.inputs[self.input_slot[vr]])
-                elif vr in self.output_slot:
-                    if self.engine is None:
-                        continue
-                    if values is None:
-                        values = self.engine.outputs(self.inputs)
-                    value = float(values[self.output_slot[vr]])
-                    if math.isfinite(value):
-                        out[i] = value
-                    else:
-                        self._error(self.engine.output_error or f"output {self.itf.variables[vr].name} is not finite")
-                elif 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].type == "Real":
-                    out[i] = float(self.params[self.itf.variables[vr].name])
-                else:
+            values = self._values if self._values is not None else self._all_values()
+            if self._real_vrs.issuperset(vrs):
+                if self._bad_vrs and not self._bad_vrs.isdisjoint(vrs):
+                    self._error(self.engine.output_error or "an output is not finite")
+                return [values[vr] for vr in vrs]
+            for vr in vrs:
+                if vr not in self._real_vrs:
                     self._error(f"fmi2GetReal: {vr} is not the value reference of a Real variable")
+            return [values[vr] if vr in self._real_vrs else 0.0 for vr in vrs]
         except Exception as exc:  # noqa: BLE001
             self._error(f"fmi2GetReal failed: {type(exc).__name__}: {exc}")
-        return [v if math.isfinite(v) else 0.0 for v in out]
+            return [0.0] * len(vrs)
+
+    def _all_values(self) -> list:
+        """Every Real value by value reference (0.0 for non-finite outputs, whose value
+        references go to ``_bad_vrs``); computed once per step or change of the inputs:
+        one product ``V [z, w] + c`` (+ the rear-end offsets' sines) with ``V`` and ``c``
+        kept per speed."""
+        e = self.engine
+        if e is not None and self._feed_problem is False:
+            self._feed_problem = e.input_problem(self.inputs, speed=False)
+        if e is None or self._feed_problem is not None:
+            return self._all_values_checked()
+        u = e.output_speed(self.inputs)
+        if u != self._values_speed:
+            O = e.output_matrix(u)
+            V = np.zeros((len(self.itf.variables), O.shape[1]))
+            V[self._input_vrs, e.m + np.arange(len(self._input_vrs))] = 1.0
+            V[self._output_vrs] = O
+            const = self._template.copy()
+            if e.eig_output >= 0:
+                const[self._output_vrs[e.eig_output]] = e.max_real_eig(u)
+            self._values_speed, self._values_V, self._values_c = u, V, const
+        values = self._values_V @ e.stacked(self.inputs) + self._values_c
+        if e.has_y:
+            values[self._output_vrs] += e.rear_offsets()
+        if not math.isfinite(values.sum()):     # finite exactly when every value is (see the engine)
+            return self._all_values_checked()
+        self._bad_vrs = frozenset()
+        self._values = values.tolist()
+        return self._values
+
+    def _all_values_checked(self) -> list:
+        """:meth:`_all_values` value by value: before initialization, with an invalid
+        input, or when a value is not finite."""
+        values = self._template.copy()
+        values[self._input_vrs] = self.inputs
+        bad = ()
+        if self.engine is not None:
+            out = self.engine.outputs(self.inputs, self._feed_problem)
+            finite = np.isfinite(out)
+            if not finite.all():
+                bad = self._output_vrs[~finite].tolist()
+                out = np.where(finite, out, 0.0)
+            values[self._output_vrs] = out
+        self._bad_vrs = frozenset(bad)
+        self._values = values.tolist()
+        return self._values
 
     def set_real(self, vrs, values):
         try:
@@ -162,6 +239,9 @@ class LCV(Fmi2Slave):
                     self._error(f"fmi2SetReal: {vr} is not the value reference of an input or a Real parameter")
         except Exception as exc:  # noqa: BLE001
             self._error(f"fmi2SetReal failed: {type(exc).__name__}: {exc}")
+        finally:
+            self._problem = self._feed_problem = False
+            self._values = None
 
     def _set_parameter(self, name: str, value) -> None:
         """A fixed parameter takes a value before initialization ends, never after."""
@@ -169,6 +249,9 @@ class LCV(Fmi2Slave):
             self._error(f"{name} is a fixed parameter: it cannot change after initialization")
         else:
             self.params[name] = value
+            self._values = None
+            self._values_speed = None
+            self._template = self._parameter_values()
 
     def get_string(self, vrs):
         out = [""] * len(vrs)
@@ -210,7 +293,7 @@ class LCV(Fmi2Slave):
     # ---------------------------------------------------------------- FMU state
     def _get_fmu_state(self):
         try:
-            return {"model": self.itf.model_name, "params": dict(self.params), "inputs": list(self.inputs),
+            return {"model": self.itf.model_name, "params": dict(self.params), "inputs": self.inputs.tolist(),
                     "initialized": self.initialized, "init_error": self.init_error,
                     "engine": None if self.engine is None else self.engine.get_state()}
         except Exception as exc:  # noqa: BLE001
@@ -236,7 +319,11 @@ class LCV(Fmi2Slave):
                         (params.get("preset"), params["tire_scale"], params["u_min"]):
                     engine = LCVEngine(self.itf, params.get("preset"), params["tire_scale"], params["u_min"])
                 engine.set_state(state["engine"])
-            self.params, self.inputs, self.engine = params, inputs, engine
+            self.params, self.inputs, self.engine = params, np.array(inputs, dtype=float), engine
+            self._problem = self._feed_problem = False
+            self._values = None
+            self._values_speed = None
+            self._template = self._parameter_values()
             self.initialized, self.init_error = bool(state["initialized"]), state["init_error"]
         except CosimError as exc:
             self._error(f"fmi2SetFMUstate: {exc}; the instance is unchanged")
