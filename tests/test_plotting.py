@@ -92,3 +92,23 @@ def test_crowded_figures_keep_their_text_apart(name):
                if ba.overlaps(bb) and min(ba.width, bb.width) > 0 and
                min(ba.x1, bb.x1) - max(ba.x0, bb.x0) > 1 and min(ba.y1, bb.y1) - max(ba.y0, bb.y0) > 1]
     assert not clashes, clashes[:5]
+
+
+def test_plan_view_draws_every_axle_above_every_body_and_measures_from_the_cab_front():
+    """Issue 22: a tractor's drive axles and a dolly hidden under the next unit's body, and
+    an overall length that left out the cab (CG to steer axle)."""
+    from matplotlib.patches import Polygon
+    from lcvreport.model.presets import load_preset
+    from lcvreport.report.plotting import FRONT_OVERHANG_M, fig_vehicle, unit_kind
+    v = load_preset("aucnat")
+    fig = fig_vehicle(v, "aucnat")
+    ax = fig.axes[0]
+    bodies = [p for p in ax.patches if isinstance(p, Polygon) and p.get_facecolor()[:3] != (0.0, 0.0, 0.0)]
+    tires = [p for p in ax.patches if isinstance(p, Polygon) and p.get_facecolor()[:3] == (0.0, 0.0, 0.0)]
+    assert len(tires) == sum(max(a.tires // 2, 1) * 2 for a in v.axles)
+    assert min(t.get_zorder() for t in tires) > max(b.get_zorder() for b in bodies)
+    assert [unit_kind(v, k) for k in range(6)] == ["tractor", "trailer", "dolly", "trailer", "dolly", "trailer"]
+    steer_x = max(a.x_m for a in v.units[0].axles)
+    rear_x = min(p.get_xy()[:, 0].min() for p in bodies)
+    expected = steer_x + FRONT_OVERHANG_M - rear_x
+    assert f"overall about {expected:.1f} m" in ax.get_title()

@@ -37,6 +37,8 @@ CAB_WIDTH_M = 96 * M_PER_IN
 FRONT_OVERHANG_M = 30 * M_PER_IN
 #: a unit shorter than this from its front coupling to its rearmost point is drawn as a dolly [m]
 DOLLY_LENGTH_M = 3.0
+#: a unit this light whose rear coupling sits over its axles is drawn as a (drawbar) dolly [kg]
+DOLLY_MASS_KG = 4000.0
 #: display units of lengths: metres per display unit
 LENGTH_UNITS = {"m": 1.0, "in": M_PER_IN}
 
@@ -50,12 +52,21 @@ def new_figure(width: float = PAGE_WIDTH_IN, height: float = 3.6, ncols: int = 1
 
 # ------------------------------------------------------------------ top views
 def unit_kind(vehicle: Vehicle, k: int) -> str:
-    """``tractor`` (first unit), ``dolly`` (short coupled unit) or ``trailer``: how a unit is drawn."""
+    """``tractor`` (first unit), ``dolly`` or ``trailer``: how a unit is drawn.
+
+    A dolly is short coupled (front coupling to rear within :data:`DOLLY_LENGTH_M`: a
+    converter dolly), or a light unit (at most :data:`DOLLY_MASS_KG`) with a unit behind it
+    whose coupling sits over its axles (within 1 m: a full trailer's drawbar dolly)."""
     if k == 0:
         return "tractor"
     u = vehicle.units[k]
     rear = min(vehicle.rear_end_x_m(k), u.rearmost_axle.x_m)
-    return "dolly" if u.front_coupling_m - rear < DOLLY_LENGTH_M else "trailer"
+    if u.front_coupling_m - rear < DOLLY_LENGTH_M:
+        return "dolly"
+    axle_x = sum(a.x_m for a in u.axles) / len(u.axles)
+    if u.rear_coupling_m is not None and abs(u.rear_coupling_m - axle_x) <= 1.0 and u.mass_kg <= DOLLY_MASS_KG:
+        return "dolly"
+    return "trailer"
 
 
 def unit_poses(vehicle: Vehicle, theta: np.ndarray | None = None) -> list[tuple[np.ndarray, float]]:
@@ -98,8 +109,8 @@ def body_extent(vehicle: Vehicle, k: int) -> tuple[float, float, float]:
         if u.rear_end_m is not None:
             rear = min(rear, u.rear_end_m)
         return max(xs) + FRONT_OVERHANG_M, rear, CAB_WIDTH_M / 2
-    if kind == "dolly":
-        return u.front_coupling_m, min(min(xs), vehicle.rear_end_x_m(k)) - 0.61, TRACK_WIDTH_M / 2 + 0.15
+    if kind == "dolly":     # the frame over the axles; the drawbar to the front coupling is drawn apart
+        return max(xs) + 0.61, min(min(xs), vehicle.rear_end_x_m(k)) - 0.61, TRACK_WIDTH_M / 2 + 0.15
     return u.front_coupling_m + 0.76, min(vehicle.rear_end_x_m(k), min(xs) - 0.6), BODY_WIDTH_M / 2
 
 
@@ -110,11 +121,15 @@ def draw_unit(ax, vehicle: Vehicle, k: int, cg: np.ndarray, psi: float, alpha: f
     u = vehicle.units[k]
     kind = unit_kind(vehicle, k)
     front, rear, hw = body_extent(vehicle, k)
-    # bodies under everything; a dolly's frame above the trailer body that covers it; every
-    # axle above all bodies (a tractor's drive axles sit under the semitrailer's front)
+    # bodies under everything; a dolly's frame and drawbar above the trailer body that covers
+    # it; every axle above all bodies (a tractor's drive axles sit under the semitrailer's front)
     ax.add_patch(Polygon(f * _rect(cg, psi, front, rear, hw), closed=True, alpha=alpha,
                          facecolor="none" if outline_only else BODY[kind], edgecolor="black", lw=0.8,
                          zorder=1.6 if kind == "dolly" else 1.0))
+    if kind == "dolly" and u.front_coupling_m > front:
+        ax.add_patch(Polygon(f * _rect(cg, psi, u.front_coupling_m, front, 0.08), closed=True, alpha=alpha,
+                             facecolor="none" if outline_only else BODY[kind], edgecolor="black", lw=0.8,
+                             zorder=1.6))
     if tires:
         nrm = np.array([-np.sin(psi), np.cos(psi)])
         for a in u.axles:
@@ -186,8 +201,8 @@ def fig_vehicle(vehicle: Vehicle, title: str) -> Figure:
     draw_vehicle(ax, vehicle)
     for k, (cg, _psi) in enumerate(poses):
         ax.plot(cg[0], cg[1], "+", color="red", ms=5, mew=0.8, zorder=6)
-    ax.set_title(f"{title} (to scale; + CG, o coupling; overall about {length:.1f} m with the cab front "
-                 f"{FRONT_OVERHANG_M:g} m ahead of the steer axle, assumed)", fontsize=8)
+    ax.set_title(f"{title} (to scale; + CG, o coupling)\noverall about {length:.1f} m (cab front assumed "
+                 f"{FRONT_OVERHANG_M:.2f} m ahead of the steer axle)", fontsize=8)
     _top_view_axes(ax, "m", ylim_m=2.6)
     return fig
 
