@@ -20,7 +20,6 @@
 #include "model.h"
 
 /* phases a call is allowed in */
-#define ANY_PHASE (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError)
 #define MASK_fmi2SetupExperiment PhaseInstantiated
 #define MASK_fmi2EnterInitializationMode PhaseInstantiated
 #define MASK_fmi2ExitInitializationMode PhaseInitializationMode
@@ -30,17 +29,6 @@
 #define MASK_fmi2SetReal (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete)
 #define MASK_fmi2SetString (PhaseInstantiated | PhaseInitializationMode)
 #define MASK_fmi2GetString ANY_PHASE
-
-static const char *phase_name(int phase)
-{
-    switch (phase) {
-    case PhaseInstantiated: return "Instantiated";
-    case PhaseInitializationMode: return "InitializationMode";
-    case PhaseStepComplete: return "StepComplete";
-    case PhaseTerminated: return "Terminated";
-    default: return "Error";
-    }
-}
 
 static void logmsg(ModelInstance *c, fmi2Status status, const char *fmt, ...)
 {

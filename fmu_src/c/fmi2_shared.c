@@ -21,6 +21,17 @@ void format_log_message(char *out, size_t size, const char *fmt, va_list ap)
     out[j] = '\0';
 }
 
+const char *phase_name(int phase)
+{
+    switch (phase) {
+    case PhaseInstantiated: return "Instantiated";
+    case PhaseInitializationMode: return "InitializationMode";
+    case PhaseStepComplete: return "StepComplete";
+    case PhaseTerminated: return "Terminated";
+    default: return "Error";
+    }
+}
+
 const char *log_category(fmi2Status status)
 {
     return status == fmi2Warning ? "logStatusWarning" : status >= fmi2Error ? "logStatusError" : "logAll";

@@ -15,4 +15,18 @@ void format_log_message(char *out, size_t size, const char *fmt, va_list ap);
 /* the FMI log category of a status: logStatusWarning, logStatusError or logAll */
 const char *log_category(fmi2Status status);
 
+/* phases of the FMI 2.0 co-simulation state machine (bit masks, as Reference-FMUs): the C
+   FMU's and the loader's (the loader enforces the same machine in front of pythonfmu) */
+typedef enum {
+    PhaseInstantiated = 1 << 0,
+    PhaseInitializationMode = 1 << 1,
+    PhaseStepComplete = 1 << 2,
+    PhaseTerminated = 1 << 3,
+    PhaseError = 1 << 4
+} Phase;
+#define ANY_PHASE (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError)
+
+/* the name of a phase, for messages */
+const char *phase_name(int phase);
+
 #endif

@@ -80,15 +80,7 @@ static void release_pythonfmu(void)
     if (p_finalizePythonInterpreter) p_finalizePythonInterpreter();
 }
 
-/* phases, as the C FMU has them (model.h) */
-enum {
-    PhaseInstantiated = 1 << 0,
-    PhaseInitializationMode = 1 << 1,
-    PhaseStepComplete = 1 << 2,
-    PhaseTerminated = 1 << 3,
-    PhaseError = 1 << 4
-};
-#define ANY_PHASE (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError)
+/* phases: the C FMU's (fmi2_shared.h), with the same masks as fmi2_api.c */
 #define MASK_fmi2SetupExperiment PhaseInstantiated
 #define MASK_fmi2EnterInitializationMode PhaseInstantiated
 #define MASK_fmi2ExitInitializationMode PhaseInitializationMode
@@ -480,17 +472,6 @@ static fmi2Status outcome(Wrapper *w, fmi2Status s, const char *function)
     return s;
 }
 
-static const char *phase_name(int phase)
-{
-    switch (phase) {
-    case PhaseInstantiated: return "Instantiated";
-    case PhaseInitializationMode: return "InitializationMode";
-    case PhaseStepComplete: return "StepComplete";
-    case PhaseTerminated: return "Terminated";
-    default: return "Error";
-    }
-}
-
 static int usable(Wrapper *w, const char *function, int mask)
 {
     if (!w) return 0;
@@ -603,41 +584,29 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolDefined, fmi2Real
                                fmi2Boolean stopDefined, fmi2Real stop)
 { SIMPLE(fmi2SetupExperiment, tolDefined, tol, start, stopDefined, stop) }
 
-fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+/* a call that moves the state machine: to ok_phase when it succeeds, else to fail_phase (0: stay) */
+static fmi2Status transition(Wrapper *w, fmi2Status s, const char *function, int ok_phase, int fail_phase)
 {
-    Wrapper *w = (Wrapper *)c;
-    if (!USABLE(fmi2EnterInitializationMode)) return fmi2Error;
-    fmi2Status s = outcome(w, p_fmi2EnterInitializationMode(w->inner), "fmi2EnterInitializationMode");
-    if (s <= fmi2Warning) w->phase = PhaseInitializationMode;
+    s = outcome(w, s, function);
+    if (s <= fmi2Warning) w->phase = ok_phase;
+    else if (fail_phase) w->phase = fail_phase;
     return s;
 }
+
+#define TRANSITION(F, OK_PHASE, FAIL_PHASE) \
+    Wrapper *w = (Wrapper *)c; \
+    if (!USABLE(F)) return fmi2Error; \
+    return transition(w, p_##F(w->inner), #F, OK_PHASE, FAIL_PHASE);
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+{ TRANSITION(fmi2EnterInitializationMode, PhaseInitializationMode, 0) }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c)
-{
-    Wrapper *w = (Wrapper *)c;
-    if (!USABLE(fmi2ExitInitializationMode)) return fmi2Error;
-    fmi2Status s = outcome(w, p_fmi2ExitInitializationMode(w->inner), "fmi2ExitInitializationMode");
-    w->phase = s <= fmi2Warning ? PhaseStepComplete : PhaseError;
-    return s;
-}
+{ TRANSITION(fmi2ExitInitializationMode, PhaseStepComplete, PhaseError) }
 
-fmi2Status fmi2Terminate(fmi2Component c)
-{
-    Wrapper *w = (Wrapper *)c;
-    if (!USABLE(fmi2Terminate)) return fmi2Error;
-    fmi2Status s = outcome(w, p_fmi2Terminate(w->inner), "fmi2Terminate");
-    if (s <= fmi2Warning) w->phase = PhaseTerminated;
-    return s;
-}
+fmi2Status fmi2Terminate(fmi2Component c) { TRANSITION(fmi2Terminate, PhaseTerminated, 0) }
 
-fmi2Status fmi2Reset(fmi2Component c)
-{
-    Wrapper *w = (Wrapper *)c;
-    if (!USABLE(fmi2Reset)) return fmi2Error;
-    fmi2Status s = outcome(w, p_fmi2Reset(w->inner), "fmi2Reset");
-    if (s <= fmi2Warning) w->phase = PhaseInstantiated;
-    return s;
-}
+fmi2Status fmi2Reset(fmi2Component c) { TRANSITION(fmi2Reset, PhaseInstantiated, 0) }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior)
 { SIMPLE(fmi2DoStep, t, h, noSetPrior) }

@@ -11,16 +11,8 @@
 #include <stddef.h>
 
 #include "fmi2Functions.h"
+#include "fmi2_shared.h"
 #include "config.h"
-
-/* phases of the FMI 2.0 co-simulation state machine (bit masks, as Reference-FMUs) */
-typedef enum {
-    PhaseInstantiated = 1 << 0,
-    PhaseInitializationMode = 1 << 1,
-    PhaseStepComplete = 1 << 2,
-    PhaseTerminated = 1 << 3,
-    PhaseError = 1 << 4
-} Phase;
 
 /* Everything that evolves: copied by fmi2GetFMUstate and serialized as bytes. */
 typedef struct {
