@@ -23,6 +23,10 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``modes``            eigenvalues, damping, mode shapes
     ``steady``           steady state -S^-1 F
     ``geometry``         rear-end offsets (eq. 4.42-4.46), global positions
+    ``manoeuvres``       steer inputs as continuous functions (step, sine, pulse, table, lane change)
+    ``exact``            exact response to them (augmented exponential), extrema between samples
+    ``field_measures``   RA peak, yaw damping (PBS style), HSTO, HSSO (SPEC 12)
+    ``criteria``         the user's limits and the verdicts
     ``discretize``       exact zero-order-hold discretization, its cache
     ``response``         TimeResponse, simulate, step_response (exact)
     ``modal``            modal superposition, exact and the thesis' method

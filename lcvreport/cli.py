@@ -130,17 +130,35 @@ def build_parser() -> argparse.ArgumentParser:
     mat.add_argument("--units", choices=("thesis", "si"), default=None,
                      help="unit system of the matrices (default: thesis for presets, si for vehicle files)")
     common(sub.add_parser("steady", help="steady state under the 1 %% rule loads, SI units"), True)
-    sim = sub.add_parser("simulate", help="exact step response from rest, streamed as CSV (or JSON), SI units")
-    common(sim, True)
+    def residuals(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("--residual", action="append", default=[], metavar="AXLE=P,T",
+                        help="residual force P [N] (+y) and moment T [N*m] (+z) on an axle; repeatable")
+        sp.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
+                        help=f"thrust angle of an axle [rad], nose-right positive, in "
+                             f"{RANGES['misalignment'].text()}; repeatable or comma-separated")
+        sp.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
+                        help=f"road crossfall [%%], positive falling toward +y, in {RANGES['crossfall'].text()}")
+
+    sim = sub.add_parser("simulate", help="exact response from rest to a steer input and residual sources, "
+                                          "streamed as CSV (or JSON), SI units")
+    common(sim, False)
+    residuals(sim)
+    sim.add_argument("--steer", metavar="SPEC", default=None,
+                     help="steer input: step:A, sine:A:F, pulse:A:D, csv:FILE, lane-change:A0:F (A0 in m/s^2 or "
+                          "with g, e.g. 0.15g); default none")
     sim.add_argument("--t-end", default=10.0, type=_ranged("t_end", what="end time in s"), metavar="T",
                      help=f"end time [s], in {RANGES['t_end'].text()}; default 10")
     sim.add_argument("--dt", default=0.01, type=_ranged("output_step", what="output step in s"), metavar="H",
                      help=f"output step [s], in {RANGES['output_step'].text()}; must divide t-end; default 0.01")
-    mea = sub.add_parser("measures", help="yaw-plane measures: damping, critical speed, RA, gains, trim (SPEC 8)")
+    mea = sub.add_parser("measures", help="yaw-plane measures: damping, RA, YDC, HSTO, HSSO, trim (SPEC 8, 12)")
     source(mea)
-    speed(mea)
+    g = mea.add_mutually_exclusive_group(required=True)
+    g.add_argument("--speed-kph", metavar="V", help="forward speed [km/h], or a sweep START:STOP:STEP")
+    g.add_argument("--speed-mph", metavar="V", help="forward speed [mph], or a sweep START:STOP:STEP")
     tires(mea)
     load(mea, False, convention=False)
+    residuals(mea)
+    mea.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
     mea.add_argument("--json", action="store_true", help="machine-readable output")
     fmu = sub.add_parser("fmu", help="FMI 2.0 co-simulation FMUs of the vehicle")
     source(fmu, masses=False)
@@ -152,6 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
     source(rep, masses=False)
     speed(rep, required=False)
     load(rep, False, convention=False)
+    residuals(rep)
     rep.add_argument("--out", required=True, metavar="DIR", help="output folder")
     rep.add_argument("--no-pdf", action="store_true", help="HTML only")
     rep.add_argument("--paper", default="letter", choices=("letter", "a4"), help="paper of the PDF (default letter)")
@@ -247,6 +266,83 @@ def _load_vector(args: argparse.Namespace, vehicle, units=SI) -> np.ndarray:
     return load_vector(vehicle, res, args.convention, units)
 
 
+def _sources(args: argparse.Namespace, vehicle):
+    """The residual sources of ``--residual``, ``--misalignment``, ``--crossfall-percent``."""
+    from .model.loads import ResidualLoads, ResidualSources
+    axles = vehicle.axle_names
+    P, T, eps = {}, {}, {}
+
+    def axle(option, name):
+        if name not in axles:
+            raise UsageError(f"argument {option}: unknown axle {name!r} of {vehicle.name}; valid: {', '.join(axles)}")
+        return name
+
+    for item in getattr(args, "residual", []) or []:
+        name, sep, value = item.partition("=")
+        parts = value.split(",")
+        if not sep or len(parts) != 2:
+            raise UsageError(f"argument --residual: expected AXLE=P,T (N, N*m), got {item!r}")
+        a = axle("--residual", name.strip())
+        if a in P:
+            raise UsageError(f"argument --residual: axle {a!r} is given twice")
+        for sym, text, key in (("P", parts[0], "residual_force"), ("T", parts[1], "residual_moment")):
+            try:
+                val = float(text)
+            except ValueError:
+                raise UsageError(f"argument --residual: {sym} of axle {a} must be a number, got {text!r}") from None
+            if not RANGES[key].contains(val):
+                raise UsageError(f"argument --residual: {sym} of axle {a} must be in {RANGES[key].text()}, got {text}")
+            (P if sym == "P" else T)[a] = val
+    for group in getattr(args, "misalignment", []) or []:
+        for item in group.split(","):
+            name, sep, value = item.partition("=")
+            if not sep:
+                raise UsageError(f"argument --misalignment: expected AXLE=RAD, got {item!r}")
+            a = axle("--misalignment", name.strip())
+            if a in eps:
+                raise UsageError(f"argument --misalignment: axle {a!r} is given twice")
+            try:
+                val = float(value)
+            except ValueError:
+                raise UsageError(f"argument --misalignment: the angle of axle {a} must be a number, got {value!r}") \
+                    from None
+            if not RANGES["misalignment"].contains(val):
+                raise UsageError(f"argument --misalignment: the angle of axle {a} must be in "
+                                 f"{RANGES['misalignment'].text()}, got {value}")
+            eps[a] = val
+    crossfall = getattr(args, "crossfall_percent", None) or 0.0
+    return ResidualSources(ResidualLoads(P, T), eps, crossfall)
+
+
+def _parse_speeds(args: argparse.Namespace) -> tuple[list[float], str]:
+    """Speeds [m/s] of ``--speed-kph``/``--speed-mph`` (one, or START:STOP:STEP) and the unit."""
+    text, unit, factor = (args.speed_kph, "km/h", MPS_PER_KPH) if args.speed_kph is not None else \
+        (args.speed_mph, "mph", MPS_PER_MPH)
+    option = "--speed-kph" if unit == "km/h" else "--speed-mph"
+    r = RANGES["speed"]
+    parts = text.split(":")
+    try:
+        nums = [float(x) for x in parts]
+    except ValueError:
+        raise UsageError(f"argument {option}: expected a number or START:STOP:STEP, got {text!r}") from None
+    if len(nums) == 1:
+        values = nums
+    elif len(nums) == 3:
+        lo, hi, step = nums
+        if not (math.isfinite(step) and step > 0 and hi >= lo):
+            raise UsageError(f"argument {option}: START:STOP:STEP needs STOP >= START and STEP > 0, got {text!r}")
+        count = int(math.floor((hi - lo) / step + 1e-9)) + 1
+        if count > 1000:
+            raise UsageError(f"argument {option}: {count} speeds; at most 1000")
+        values = [lo + k * step for k in range(count)]
+    else:
+        raise UsageError(f"argument {option}: expected a number or START:STOP:STEP, got {text!r}")
+    for val in values:
+        if not r.contains(val * factor):
+            raise UsageError(f"argument {option}: must be in {r.text(1 / factor, unit)}, got {val:g}")
+    return [val * factor for val in values], unit
+
+
 # ---------------------------------------------------------------------------- commands
 def _cmd_presets(args, out: _Out) -> int:
     from .model.presets import PRESET_LABELS, PRESETS
@@ -331,11 +427,9 @@ def _cmd_steady(args, out: _Out) -> int:
 
 
 def _cmd_simulate(args, out: _Out) -> int:
-    from .analysis.geometry import rear_offsets
-    from .analysis.response import iter_step_response
-    from .model.builder import system_coefficients
+    from .analysis.exact import ManoeuvreError, final_state, response
+    from .analysis.manoeuvres import SteerError, parse_steer, step
     v = _vehicle(args)
-    F = _load_vector(args, v)
     steps_f = args.t_end / args.dt
     steps = int(round(steps_f))
     if args.dt > args.t_end:
@@ -347,54 +441,123 @@ def _cmd_simulate(args, out: _Out) -> int:
     rows = RANGES["output_rows"]
     if steps + 1 > rows.high:
         raise UsageError(f"arguments --t-end/--dt: {steps + 1} rows; at most {rows.high:.0f} (raise --dt)")
-    n = v.n_units
+    try:
+        steer = parse_steer(args.steer) if args.steer is not None else step(0.0)
+    except SteerError as exc:
+        raise UsageError(f"argument --steer: {exc}") from None
+    if args.steer is not None and not v.steered_axles:
+        raise UsageError(f"argument --steer: {v.name} has no steered axle")
+    F = _load_vector(args, v) if args.load is not None else np.zeros(v.n_states)
+    try:
+        F = F + _sources(args, v).vector(v, args.tire_scale)
+    except (KeyError, RangeError) as exc:
+        raise UsageError(f"argument: {exc.args[0]}") from None
     u = _speed_mps(args)
-    co = system_coefficients(v)
-    Ca, Da = co.acceleration_maps(u, args.tire_scale)
-    aF = Da @ F
-    names = (["time_s", "v1_m_per_s"] + [f"r{i + 1}_rad_per_s" for i in range(n)] +
-             [f"{nm}_rad" for nm in v.state_names[n + 1:]] + [f"y{k + 2}_m" for k in range(n - 1)] +
-             [f"ay{i + 1}_m_per_s2" for i in range(n)])
-    if args.json:
-        out.write('{"columns": ' + json.dumps(names) + ', "rows": [')
-    else:
-        out.line(",".join(names))
+    chunk = 20000                                  # rows per exact run: constant memory
     first = True
-    for t, z in iter_step_response(v, u, F, args.dt, steps, args.tire_scale):
-        x = z[:2 * n]
-        row = np.concatenate([[t], x, rear_offsets(v, x[n + 1:]), Ca @ x + aF])
-        _finite(row)
+    t_a, state, k = 0.0, None, 0
+    while k < steps:
+        n = min(chunk, steps - k)
+        t_b = (k + n) * args.dt
+        try:
+            r = response(v, u, steer, t_b, args.dt, F, args.tire_scale, t_start=k * args.dt, state=state)
+        except ManoeuvreError as exc:
+            raise UsageError(f"argument --steer: {exc}") from None
+        M = r.matrix()
+        _finite(M)
+        if first:
+            names = r.columns()
+            if args.json:
+                out.write('{"columns": ' + json.dumps(names) + ', "rows": [')
+            else:
+                out.line(",".join(names))
+        body = M if first else M[1:]
         if args.json:
-            out.write(("" if first else ", ") + json.dumps([float(val) for val in row]))
+            out.write(("" if first else ", ") + ", ".join(json.dumps(row) for row in body.tolist()))
         else:
-            out.line(",".join(f"{val:.10g}" for val in row))
+            out.write("".join(",".join(f"{val:.10g}" for val in row) + "\n" for row in body.tolist()))
         first = False
+        state = final_state(r)
+        k += n
     if args.json:
         out.line("]}")
     return 0
 
 
 def _cmd_measures(args, out: _Out) -> int:
+    from .analysis.criteria import CriteriaError, judge, load_criteria
     from .analysis.measures import measure_set
     v = _vehicle(args)
+    speeds, unit = _parse_speeds(args)
     units = _load_units(args, v) if args.load is not None else None
-    try:
-        m = measure_set(v, _speed_mps(args), args.tire_scale, units)
-    except ValueError as exc:
-        if "static_load_N" in str(exc):
-            raise UsageError(f"argument --load: {exc}") from None
-        raise
-    doc = m.to_dict()
-    _finite(*(val for val in doc.values() if isinstance(val, (int, float, list))))
+    sources = _sources(args, v)
+    criteria = None
+    if args.criteria is not None:
+        try:
+            criteria = load_criteria(args.criteria)
+        except CriteriaError as exc:
+            raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
+    docs, sets = [], []
+    for u in speeds:
+        try:
+            m = measure_set(v, u, args.tire_scale, units, sources=sources if sources else None)
+        except ValueError as exc:
+            if "static_load_N" in str(exc):
+                raise UsageError(f"argument --load: {exc}") from None
+            raise
+        doc = m.to_dict()
+        if criteria is not None:
+            doc["verdicts"] = judge(criteria, doc)
+        docs.append(doc)
+        sets.append(m)
+    for doc in docs:
+        _finite(*(val for val in doc.values() if isinstance(val, (int, float))),
+                *(val for val in doc.values() if isinstance(val, list) and val and not isinstance(val[0], dict)))
+    sweep = len(speeds) > 1
     if args.json:
-        out.json(doc)
+        out.json(docs if sweep else docs[0])
         return 0
-    out.line(f"{v.name} at {_speed_text(args)} ({mps_to_kph(m.speed_mps):.1f} km/h), tire scale {args.tire_scale:g}")
+    if sweep:
+        cols = _flat_columns(docs[0], v)
+        out.line(",".join(cols))
+        for doc in docs:
+            flat = _flatten(doc, v)
+            out.line(",".join("" if flat.get(c) is None else (f"{flat[c]:.10g}" if isinstance(flat[c], float)
+                                                             else str(flat[c])) for c in cols))
+        return 0
+    m, doc = sets[0], docs[0]
+    out.line(f"{v.name} at {args.speed_kph or args.speed_mph} {unit} ({mps_to_kph(m.speed_mps):.1f} km/h), tire scale "
+             f"{args.tire_scale:g}")
     for row in m.rows():
         val = row["value"]
         text = val if isinstance(val, str) else f"{val:.6g}"
         out.line(f"  {row['measure']:42s} {text:>12s} {row['unit']:10s} {row['note']}")
+    if criteria is not None:
+        out.line(f"verdicts against {args.criteria} (limits and their sources as the file gives them):")
+        for key, verdict in doc["verdicts"].items():
+            out.line(f"  {key:28s} {verdict['verdict']:14s} {verdict['note']}")
     return 0
+
+
+def _flatten(doc: dict, vehicle) -> dict:
+    flat = {}
+    for key, val in doc.items():
+        if key == "ay_gain_per_unit":
+            for name, g in zip(vehicle.unit_names, val or [None] * vehicle.n_units):
+                flat[f"ay_gain_{name}_m_per_s2_per_rad"] = g
+        elif key == "trim":
+            flat["trim_delta_rad"] = None if val is None else val["delta_rad"]
+            flat["trim_offtracking_m"] = None if val is None else val["offtracking_m"]
+        elif key == "verdicts":
+            for k, verdict in val.items():
+                flat[f"verdict_{k}"] = verdict["verdict"]
+        else:
+            flat[key] = val
+    return flat
+
+
+def _flat_columns(doc: dict, vehicle) -> list[str]:
+    return list(_flatten(doc, vehicle))
 
 
 def _cmd_fmu(args, out: _Out) -> int:

@@ -23,6 +23,11 @@ steer_angle            rad            [-1, 1]             +-57 deg: far beyond s
 residual_force         N              [-1e6, 1e6]         P per axle (1 % rule: ~1e3 N)
 residual_moment        N*m            [-1e6, 1e6]         T per axle
 frequency              Hz             [0.01, 10]          RA and gain frequency
+pulse_duration         s              [0.01, 10]          a half-sine steer pulse
+lateral_acceleration   m/s^2          [-20, 20]           a lane change's A0 (2 g)
+misalignment           rad            [-0.05, 0.05]       thrust angle of an axle (2.9 deg;
+                                                          real ones are below 0.5 deg)
+crossfall              %              [-20, 20]           road crossfall (crown ~2 %)
 =====================  =============  ==================  ==============================
 
 The vehicle-file limits (:data:`VEHICLE`) are as generous: they exist so that a
@@ -142,6 +147,12 @@ RANGES: dict[str, Range] = dict([
     ("residual_force", Range("P", "N", -1e6, 1e6, description="residual lateral force of one axle")),
     ("residual_moment", Range("T", "N*m", -1e6, 1e6, description="residual aligning moment of one axle")),
     ("frequency", Range("frequency", "Hz", 0.01, 10.0, description="steer frequency of RA and gains")),
+    ("pulse_duration", Range("pulse duration", "s", 0.01, 10.0, description="duration of a half-sine steer pulse")),
+    ("lateral_acceleration", Range("lateral acceleration", "m/s^2", -20.0, 20.0,
+                                   description="prescribed lateral acceleration of a lane change (2 g)")),
+    ("misalignment", Range("misalignment", "rad", -0.05, 0.05,
+                           description="axle misalignment (thrust angle), nose-right positive (2.9 deg)")),
+    ("crossfall", Range("crossfall", "%", -20.0, 20.0, description="road crossfall, positive falling toward +y")),
 ])
 
 #: vehicle-file limits (SI, per tire where the file is per tire)

@@ -88,7 +88,9 @@ def test_every_command_works_on_every_example(name):
     rows = csv.strip().splitlines()
     assert code == 0 and len(rows) == 6
     header = rows[0].split(",")
-    assert header[:2] == ["time_s", "v1_m_per_s"] and header[-1] == f"ay{v.n_units}_m_per_s2"
+    assert header[:3] == ["time_s", "delta_rad", "v1_m_per_s"] and header[-1] == f"y{v.n_units}_m"
+    assert f"ay{v.n_units}_m_per_s2" in header and "psi1_rad" in header and "Y1_m" in header
+    assert all(f"Y_{a.name}_m" in header for a in v.axles)
     mats = lcv_json("matrices", "--vehicle", path, "--speed-kph", "88")
     assert mats["units"].startswith("SI")
     np.testing.assert_allclose(mats["M"], system_matrices(v, 88 / 3.6)[0], rtol=1e-14)

@@ -26,8 +26,8 @@ Examples
 >>> from lcvreport import load_preset
 >>> from lcvreport.units import kph_to_mps
 >>> m = measure_set(load_preset("aucnat"), kph_to_mps(88.0), load_units=["trailer2", "trailer3"])
->>> sorted(m.to_dict())
-['ay_gain_per_unit', 'critical_speed_kph', 'least_damped_frequency_hz', 'least_damping_ratio', 'ra_frequency', 'ra_single_sine', 'speed_mps', 'trim']
+>>> sorted(m.to_dict())[:6]
+['ay_gain_per_unit', 'critical_speed_kph', 'hsso_m', 'hsto_m', 'least_damped_frequency_hz', 'least_damping_ratio']
 """
 from __future__ import annotations
 
@@ -53,7 +53,7 @@ U_MIN_DEFAULT_MPS = 2.2352
 #: resolution of the critical speed [km/h]
 CRITICAL_SPEED_RESOLUTION_KPH = 0.1
 #: single sine: step [s], time after the sine [s], default amplitude [rad]
-SINGLE_SINE_STEP_S = 1e-3
+SINGLE_SINE_STEP_S = 2e-3
 SINGLE_SINE_TAIL_S = 8.0
 SINGLE_SINE_DELTA0_RAD = 0.01
 
@@ -165,11 +165,13 @@ class SingleSine:
     time : numpy.ndarray, shape (K,)
         Sample times from the start of the steer [s].
     delta : numpy.ndarray, shape (K,)
-        Steer angle held from each sample [rad].
+        Steer angle (the continuous sine) at the samples [rad].
     ay : numpy.ndarray, shape (K, N)
-        Lateral acceleration of every unit's CG [m/s^2].
+        Lateral acceleration of every unit's CG at the samples [m/s^2].
     frequency_hz, delta0_rad, speed_mps : float
     vehicle : Vehicle
+    peaks : numpy.ndarray, shape (N,)
+        max|a_i| per unit on the continuous response [m/s^2] (between the samples).
     """
 
     time: np.ndarray
@@ -179,17 +181,12 @@ class SingleSine:
     delta0_rad: float
     speed_mps: float
     vehicle: Vehicle = field(repr=False, default=None)
+    peaks: np.ndarray = None
 
     @property
     def rearward_amplification(self) -> float:
-        """max|a_N| / max|a_1| [-]."""
-        peaks = np.abs(self.ay).max(axis=0)
-        return float(peaks[-1] / peaks[0])
-
-    @property
-    def peaks(self) -> np.ndarray:
-        """max|a_i| per unit [m/s^2]."""
-        return np.abs(self.ay).max(axis=0)
+        """max|a_N| / max|a_1| [-] on the continuous response."""
+        return float(self.peaks[-1] / self.peaks[0])
 
     def plot(self, ax=None):
         """Time histories of every unit's a_i (a :class:`matplotlib.figure.Figure`)."""
@@ -200,76 +197,28 @@ class SingleSine:
 def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_HZ,
                 delta0_rad: float = SINGLE_SINE_DELTA0_RAD, tire_scale: float = 1.0,
                 step_s: float = SINGLE_SINE_STEP_S, tail_s: float = SINGLE_SINE_TAIL_S) -> SingleSine:
-    """The single-sine manoeuvre from rest, exact for the sampled steer (zero-order hold).
-
-    One period of ``delta = delta0 sin(2 pi f t)`` sampled every ``step_s`` and held,
-    then straight ahead for ``tail_s``; the lateral accelerations of every unit's CG at
-    every sample.
-
-    The response is evaluated in closed form over the modes of ``A = M^-1 S`` (with
-    ``mu = exp(lambda h)``, ``z = exp(i 2 pi f h)``, the modal response to the sampled
-    sine is ``sum_j mu^(k-1-j) z^j = (z^k - mu^k)/(z - mu)``, and after the sine
-    ``xi_k = mu^(k-K) xi_K``), straight onto the outputs, one mode of each complex pair
-    (the other is its conjugate).  Equal to stepping the exact discretization (tested);
-    falls back to stepping if the eigenvectors are ill-conditioned.
+    """The single-sine manoeuvre from rest (SPEC sections 8 and 11): the continuous steer
+    ``delta = delta0 sin(2 pi f t)`` for ``0 <= t <= 1/f``, then straight ahead for
+    ``tail_s``; the exact response (:func:`lcvreport.analysis.exact.response`), sampled
+    every ``step_s``, its peaks located on the continuous response.
 
     Examples
     --------
     >>> from lcvreport import load_preset
     >>> s = single_sine(load_preset("aucnat"), 24.4444)
     >>> s.ay.shape, round(s.rearward_amplification, 2)
-    ((10501, 6), 4.79)
+    ((5251, 6), 4.79)
     """
-    check_speed(speed_mps)
-    check_tire_scale(tire_scale)
+    from .exact import response
+    from .manoeuvres import sine
     f = float(_freq(f_hz))
-    RANGES["steer_angle"].check(delta0_rad, "delta0")
-    co = system_coefficients(vehicle)
-    A, G = co.state_derivative_maps(speed_mps, tire_scale)
-    bd = G @ co.B_delta(tire_scale)
-    Ca, Da = co.acceleration_maps(speed_mps, tire_scale)
-    da = Da @ co.B_delta(tire_scale)
-    h = float(step_s)
-    n_sine = int(round(1.0 / (f * h)))
-    n_total = int(round((1.0 / f + tail_s) / h))
-    k = np.arange(n_total + 1)
-    t = k * h
-    delta = np.where(k < n_sine, delta0_rad * np.sin(2 * np.pi * f * t), 0.0)
-    lam, V = np.linalg.eig(A)
-    theta = 2 * np.pi * f * h
-    zc = np.exp(1j * theta)
-    if np.linalg.cond(V) < 1e8 and np.all(np.abs(zc - np.exp(lam * h)) > 1e-9) and np.all(lam != 0):
-        # one of each conjugate pair, counted twice; real modes once
-        keep = lam.imag >= 0
-        weight = np.where(np.abs(lam.imag) > 0, 2.0, 1.0)[keep]
-        beta = np.linalg.solve(V, bd)[keep]
-        lam_k, W = lam[keep], (Ca @ V)[:, keep].T * weight[:, None]    # modal -> output, (m, N)
-        mu = np.exp(lam_k * h)
-        g = beta * (mu - 1.0) / lam_k * delta0_rad / 2j
-        p, q = 1.0 / (zc - mu), 1.0 / (np.conj(zc) - mu)
-        n_after = n_total - n_sine
-        E = np.exp(np.outer(np.arange(max(n_sine, n_after) + 1), lam_k * h))       # mu^k, (rows, m)
-        ks = k[:n_sine + 1]
-        # xi_k = g (z^k p - conj(z)^k q - mu^k (p - q)) for k <= n_sine
-        ay_sine = (np.exp(1j * theta * ks)[:, None] * ((g * p) @ W)[None, :]
-                   - np.exp(-1j * theta * ks)[:, None] * ((g * q) @ W)[None, :]
-                   - E[:n_sine + 1] @ ((g * (p - q))[:, None] * W)).real
-        xi_end = g * (zc ** n_sine * p - np.conj(zc) ** n_sine * q - mu ** n_sine * (p - q))
-        ay_after = (E[1:n_after + 1] @ (xi_end[:, None] * W)).real
-        ay = np.vstack([ay_sine, ay_after]) + delta[:, None] * da
-    else:  # pragma: no cover - defective or resonant: step the exact discretization
-        from .discretize import augmented_state_matrix, discretize
-        Aa, Ga = augmented_state_matrix(co, speed_mps, tire_scale)
-        Ad, Gd = discretize(Aa, Ga, h)
-        n = vehicle.n_states
-        x = np.zeros((k.size, n))
-        z = np.zeros(n + 2)
-        b = Gd @ co.B_delta(tire_scale)
-        for i in range(k.size - 1):
-            z = Ad @ z + b * delta[i]
-            x[i + 1] = z[:n]
-        ay = x @ Ca.T + delta[:, None] * da
-    return SingleSine(t, delta, ay, f, float(delta0_rad), float(speed_mps), vehicle)
+    steer = sine(delta0_rad, f)
+    t_end = round((1.0 / f + tail_s) / step_s) * step_s
+    r = response(vehicle, speed_mps, steer, t_end, step_s, tire_scale=tire_scale)
+    names = [f"ay{i + 1}" for i in range(vehicle.n_units)]
+    ay = np.column_stack([r[n] for n in names])
+    peaks = np.array([r.peak_abs(n) for n in names])
+    return SingleSine(r.time, r["delta"], ay, f, float(delta0_rad), float(speed_mps), vehicle, peaks)
 
 
 @dataclass(frozen=True)
@@ -422,6 +371,14 @@ class MeasureSet:
     f_hz: float = RA_FREQUENCY_HZ
     #: measure key -> why it is null (e.g. no steered axle: no steer input to respond to)
     undefined: dict = field(default_factory=dict)
+    ra_peak: float | None = None
+    ra_peak_frequency_hz: float | None = None
+    yaw_damping_coefficient: float | None = None
+    hsto_m: float | None = None
+    ra_lane_change: float | None = None
+    hsso_m: float | None = None
+    steady_turn_delta_rad: float | None = None
+    sources: object = None
 
     def to_dict(self) -> dict:
         """The SPEC section 8 JSON document."""
@@ -430,6 +387,8 @@ class MeasureSet:
                "critical_speed_kph": self.critical_speed_kph, "ra_frequency": self.ra_frequency,
                "ra_single_sine": self.ra_single_sine,
                "ay_gain_per_unit": None if self.ay_gain_per_unit is None else list(self.ay_gain_per_unit)}
+        for key in FIELD_KEYS:
+            doc[key] = getattr(self, key)
         if self.trim is not None:
             doc["trim"] = {"delta_rad": self.trim.delta_rad, "offtracking_m": self.trim.offtracking_m}
         elif "trim" in self.undefined:
@@ -462,20 +421,41 @@ class MeasureSet:
         for k, (name, g) in enumerate(zip(self.vehicle.unit_names, self.ay_gain_per_unit or ())):
             rows.append({"measure": f"lateral acceleration gain, {name}", "value": g, "unit": "m/s²/rad",
                          "note": f"|G_{k + 1}(j2π·{f})|", "json_key": f"ay_gain_per_unit[{k}]"})
+        for key, (label, unit, note) in FIELD_ROWS.items():
+            value = getattr(self, key)
+            rows.append({"measure": label, "value": num(value), "unit": unit,
+                         "note": self.undefined.get(key, note), "json_key": key})
         if "trim" in self.undefined:
             rows.append({"measure": "trim", "value": "none", "unit": "", "note": self.undefined["trim"],
                          "json_key": "trim"})
         if self.trim is not None:
+            what = "; ".join(x for x in (f"1 % rule on {', '.join(self.load_units)}" if self.load_units else "",
+                                          self.sources.describe() if self.sources else "") if x)
             rows.append({"measure": "trim steer angle", "value": self.trim.delta_rad, "unit": "rad",
-                         "note": f"1 % rule on {', '.join(self.load_units)}", "json_key": "trim.delta_rad"})
+                         "note": what, "json_key": "trim.delta_rad"})
             rows.append({"measure": "trimmed offtracking", "value": self.trim.offtracking_m, "unit": "m",
                          "note": "rearmost axle path − steered axle path, +y", "json_key": "trim.offtracking_m"})
         return rows
 
 
+#: the SPEC section 12 keys of :meth:`MeasureSet.to_dict`, in order
+FIELD_KEYS = ("ra_peak", "ra_peak_frequency_hz", "yaw_damping_coefficient", "hsto_m", "ra_lane_change", "hsso_m",
+              "steady_turn_delta_rad")
+#: their table rows: label, unit, definition
+FIELD_ROWS = {
+    "ra_peak": ("rearward amplification, peak", "-", "max RA(f) over 0.1-2 Hz"),
+    "ra_peak_frequency_hz": ("frequency of the RA peak", "Hz", "where RA(f) is largest"),
+    "yaw_damping_coefficient": ("yaw damping coefficient", "-", "ratio method, pulse 0.01 rad 0.5 s, 40 s"),
+    "hsto_m": ("high-speed transient offtracking", "m", "lane change 0.15 g 0.4 Hz, rear axle overshoot"),
+    "ra_lane_change": ("rearward amplification, lane change", "-", "max|a_N| / max|a_s| in that lane change"),
+    "hsso_m": ("high-speed steady-state offtracking", "m", "393 m turn: rear axle radius - steered axle radius"),
+    "steady_turn_delta_rad": ("steer angle of the 393 m turn", "rad", "the steady turn of HSSO"),
+}
+
+
 def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, load_units=None,
-                f_hz: float = RA_FREQUENCY_HZ) -> MeasureSet:
-    """Every SPEC section 8 measure of ``vehicle`` at ``speed_mps`` [m/s].
+                f_hz: float = RA_FREQUENCY_HZ, sources=None) -> MeasureSet:
+    """Every SPEC section 8 and 12 measure of ``vehicle`` at ``speed_mps`` [m/s].
 
     Parameters
     ----------
@@ -483,29 +463,60 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     speed_mps : float
     tire_scale : float
     load_units : list of str, optional
-        Units carrying the 1 % rule (P along +y, T about +z) for the trim; no trim if None.
+        Units carrying the 1 % rule (P along +y, T about +z) for the trim.
     f_hz : float
         Frequency of the RA measures and gains [Hz].
+    sources : lcvreport.model.loads.ResidualSources, optional
+        Further residual sources for the trim (per-axle P and T, misalignment, crossfall);
+        with ``load_units`` the 1 % rule adds to them.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> m = measure_set(load_preset("tractor_semitrailer"), 24.4444)
+    >>> sorted(m.to_dict())[:4]
+    ['ay_gain_per_unit', 'critical_speed_kph', 'hsso_m', 'hsto_m']
     """
+    from . import field_measures as fm
+    from .exact import ManoeuvreError
     zeta, f_zeta = least_damping(vehicle, speed_mps, tire_scale)
     units = tuple(load_units) if load_units else ()
+    has_sources = bool(units) or bool(sources)
     if not vehicle.steered_axles:
         why = "undefined: the vehicle has no steered axle, so no steer input to respond to or trim with"
-        undefined = {k: why for k in ("ra_frequency", "ra_single_sine", "ay_gain_per_unit")}
-        if units:
+        undefined = {k: why for k in ("ra_frequency", "ra_single_sine", "ay_gain_per_unit") + FIELD_KEYS}
+        if has_sources:
             undefined["trim"] = why
         return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
-                          critical_speed(vehicle, tire_scale), None, None, None, None, units, float(f_hz), undefined)
+                          critical_speed(vehicle, tire_scale), None, None, None, None, units, float(f_hz), undefined,
+                          sources=sources)
     gains = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
     ss = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale)
     tr = None
-    if units:
-        F = load_vector(vehicle, one_percent_rule(vehicle, list(units)))
+    if has_sources:
+        F = np.zeros(vehicle.n_states)
+        if units:
+            F = F + load_vector(vehicle, one_percent_rule(vehicle, list(units)))
+        if sources:
+            F = F + sources.vector(vehicle, tire_scale)
         tr = trim(vehicle, speed_mps, F, tire_scale)
         check_trim(tr)
+    undefined = {}
+    peak = fm.ra_peak(vehicle, speed_mps, tire_scale)
+    ydc = fm.yaw_damping_coefficient(vehicle, speed_mps, tire_scale)
+    if ydc.value is None:
+        undefined["yaw_damping_coefficient"] = f"undefined: {ydc.why}"
+    try:
+        lc = fm.lane_change_measures(vehicle, speed_mps, tire_scale)
+        hsto, ra_lc = lc.hsto_m, lc.ra_lane_change
+    except ManoeuvreError as exc:
+        hsto = ra_lc = None
+        undefined["hsto_m"] = undefined["ra_lane_change"] = f"undefined: {exc}"
+    turn = fm.steady_turn(vehicle, speed_mps, tire_scale)
     return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
                       critical_speed(vehicle, tire_scale), float(gains[-1] / gains[0]), ss.rearward_amplification,
-                      [float(g) for g in gains], tr, units, float(f_hz))
+                      [float(g) for g in gains], tr, units, float(f_hz), undefined, peak.value, peak.frequency_hz,
+                      ydc.value, hsto, ra_lc, turn.hsso_m, turn.delta_rad, sources)
 
 
 def check_trim(tr: Trim) -> None:

@@ -64,6 +64,11 @@ class SystemCoefficients:
         Generalized force per force unit of residual lateral force P (along +y), per axle.
     B_T : numpy.ndarray, shape (2N, n_axles)
         Generalized force per moment unit of residual aligning moment T (about +z), per axle.
+    B_eps : numpy.ndarray, shape (2N, n_axles)
+        Generalized force per radian of misalignment (thrust angle) of each axle at tire
+        scale 1: the axle's slip angle gains +eps (SPEC section 11).
+    B_crossfall : numpy.ndarray, shape (2N,)
+        Generalized force per unit of sin(atan(crossfall)): m_i g at every unit's CG, along +y.
     Jv, Jr : numpy.ndarray, shape (N, N+1)
         Partial velocities: lateral velocity and yaw rate of every unit per generalized speed.
     K : numpy.ndarray, shape (N, N-1)
@@ -84,6 +89,8 @@ class SystemCoefficients:
     Jv: np.ndarray
     Jr: np.ndarray
     K: np.ndarray
+    B_eps: np.ndarray = None
+    B_crossfall: np.ndarray = None
 
     @property
     def n_states(self) -> int:
@@ -155,6 +162,11 @@ def kinematic_jacobians(rear: np.ndarray, front: np.ndarray) -> tuple[np.ndarray
 
     Returns
     -------
+    B_eps : numpy.ndarray, shape (2N, n_axles)
+        Generalized force per radian of misalignment (thrust angle) of each axle at tire
+        scale 1: the axle's slip angle gains +eps (SPEC section 11).
+    B_crossfall : numpy.ndarray, shape (2N,)
+        Generalized force per unit of sin(atan(crossfall)): m_i g at every unit's CG, along +y.
     Jv, Jr : numpy.ndarray, shape (N, N+1)
     K : numpy.ndarray, shape (N, N-1)
     """
@@ -239,17 +251,22 @@ def system_coefficients(vehicle: Vehicle, units: UnitSystem = SI) -> SystemCoeff
 
     B_P = np.zeros((ns, len(axles)))
     B_T = np.zeros((ns, len(axles)))
+    B_eps = np.zeros((ns, len(axles)))
     Bdelta = np.zeros(ns)
     for col, (i, ax) in enumerate(zip(which, axles)):
         x = ax.x_m / L
         B_P[:nq, col] = Jv[i] + x * Jr[i]
         B_T[:nq, col] = Jr[i]
+        CF = ax.cornering_stiffness_axle_N_per_rad / Fu
+        CM = ax.aligning_stiffness_axle_Nm_per_rad / (Fu * L)
+        # an angle added to the slip angle: F = CF angle at the axle, aligning moment -CM angle
+        B_eps[:nq, col] = CF * Jv[i] + (CF * x - CM) * Jr[i]
         if ax.steered:
-            CF = ax.cornering_stiffness_axle_N_per_rad / Fu
-            CM = ax.aligning_stiffness_axle_Nm_per_rad / (Fu * L)
-            # F = CF delta at the axle, aligning moment -CM delta
-            Bdelta[:nq] += CF * Jv[i] + (CF * x - CM) * Jr[i]
-    arrays = (M0, M1, S0, Sinv, Su, Skin, Bdelta, B_P, B_T, Jv, Jr, K)
+            Bdelta[:nq] += B_eps[:nq, col]
+    g = 9.80665 / L                                   # standard gravity in the unit system
+    B_crossfall = np.zeros(ns)
+    B_crossfall[:nq] = Jv.T @ (m * g)
+    arrays = (M0, M1, S0, Sinv, Su, Skin, Bdelta, B_P, B_T, Jv, Jr, K, B_eps, B_crossfall)
     for arr in arrays:
         arr.setflags(write=False)
     return SystemCoefficients(vehicle, units, *arrays)

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import math
+
 import numpy as np
 
 from ..ranges import RANGES, RangeError
@@ -169,3 +171,68 @@ def load_vector(vehicle: Vehicle, loads: ResidualLoads, convention: str = "consi
         F = F.copy()
         F[1:vehicle.n_units + 1] /= IN_PER_FT
     return F
+
+
+@dataclass(frozen=True)
+class ResidualSources:
+    """Every constant residual source of SPEC section 11, SI.
+
+    Attributes
+    ----------
+    loads : ResidualLoads
+        Per-axle residual force P [N] and moment T [N*m].
+    misalignment_rad : dict
+        Axle name -> thrust angle [rad], nose-right positive: the axle's slip angle gains it.
+    crossfall_percent : float
+        Road crossfall [%], positive when the road falls toward +y: m_i g sin(atan(c/100))
+        along +y at every unit's CG.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> src = ResidualSources(misalignment_rad={"31": 0.002}, crossfall_percent=2.0)
+    >>> src.vector(load_preset("aucnat")).shape
+    (12,)
+    """
+
+    loads: ResidualLoads = field(default_factory=ResidualLoads)
+    misalignment_rad: dict = field(default_factory=dict)
+    crossfall_percent: float = 0.0
+
+    def __bool__(self) -> bool:
+        return bool(self.loads.P_N or self.loads.T_Nm or self.misalignment_rad or self.crossfall_percent)
+
+    def vector(self, vehicle: Vehicle, tire_scale: float = 1.0) -> np.ndarray:
+        """The generalized force F (2N,) of every source, SI (the misalignment's scales
+        with the tire coefficients, the others do not).
+
+        Raises
+        ------
+        KeyError
+            An axle the vehicle does not have.
+        lcvreport.ranges.RangeError
+            A value outside :data:`lcvreport.ranges.RANGES`.
+        """
+        co = system_coefficients(vehicle)
+        P, T = self.loads.vectors(vehicle)
+        names = vehicle.axle_names
+        unknown = set(self.misalignment_rad) - set(names)
+        if unknown:
+            raise KeyError(f"axles {sorted(unknown)} are not on {vehicle.name} (axles: {', '.join(names)})")
+        eps = np.array([self.misalignment_rad.get(a, 0.0) for a in names], dtype=float)
+        for a, e in zip(names, eps):
+            RANGES["misalignment"].check(e, f"misalignment of axle {a}")
+        c = RANGES["crossfall"].check(self.crossfall_percent, "crossfall")
+        return (co.B_P @ P + co.B_T @ T + tire_scale * (co.B_eps @ eps)
+                + math.sin(math.atan(c / 100.0)) * co.B_crossfall)
+
+    def describe(self) -> str:
+        """The sources in words, for captions and notes."""
+        parts = []
+        if self.loads.P_N or self.loads.T_Nm:
+            parts.append("P, T on " + ", ".join(sorted(set(self.loads.P_N) | set(self.loads.T_Nm))))
+        if self.misalignment_rad:
+            parts.append("misalignment " + ", ".join(f"{a} {e:g} rad" for a, e in self.misalignment_rad.items()))
+        if self.crossfall_percent:
+            parts.append(f"crossfall {self.crossfall_percent:g} %")
+        return "; ".join(parts) or "none"

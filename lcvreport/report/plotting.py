@@ -507,6 +507,32 @@ def plot_time_response(response, signals=None, ax=None, **style) -> Figure:
     return fig
 
 
+def plot_manoeuvre(response, signals=None, ax=None) -> Figure:
+    """Signals of a :class:`lcvreport.analysis.exact.ManoeuvreResponse` against time
+    (default: every unit's lateral acceleration [m/s^2], the steer angle [deg] dotted on
+    a second axis)."""
+    if ax is None:
+        fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
+    else:
+        fig = ax.figure
+    v = response.vehicle
+    signals = signals or [f"ay{i + 1}" for i in range(v.n_units)]
+    for i, name in enumerate(signals):
+        ax.plot(response.time, response[name], color=PALETTE[i % len(PALETTE)], lw=1.0, label=name)
+    ax2 = ax.twinx()
+    ax2.plot(response.time, np.degrees(response["delta"]), color="black", lw=0.8, ls=":", label="steer angle")
+    ax2.set_ylabel("steer angle [deg] (dotted)")
+    ax2.tick_params(labelsize=SMALL_PT)
+    ax.set_xlabel("time [s]")
+    units = {"ay": "m/s²", "Y_": "m", "the": "rad", "r": "rad/s", "y": "m"}
+    unit = next((u for k, u in units.items() if signals[0].startswith(k)), "SI")
+    ax.set_ylabel(f"{', '.join(signals[:3])}{' ...' if len(signals) > 3 else ''} [{unit}]")
+    ax.grid(True, lw=0.3)
+    ax.legend(handles=ax.get_lines() + ax2.get_lines(), fontsize=SMALL_PT, ncol=4, loc="upper center",
+              bbox_to_anchor=(0.5, -0.18), frameon=False)
+    return fig
+
+
 def plot_single_sine(ss, ax=None) -> Figure:
     """Lateral accelerations [m/s^2] of every unit in a single-sine manoeuvre, and the steer angle."""
     if ax is None:

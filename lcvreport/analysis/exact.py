@@ -1,0 +1,434 @@
+"""Exact response to continuous steer inputs and constant residual sources (SPEC section 11).
+
+On each piece of the input (:mod:`lcvreport.analysis.manoeuvres`) the model, the global
+position (psi1, Y1), the input's generator ``xi' = E xi`` and a constant 1 form one
+homogeneous linear system ``z' = Mz z``::
+
+    z = [x, psi1, Y1, xi, 1],   Mz = [[A_aug, b h, g], [0, E, 0], [0, 0, 0]]
+
+so ``z(t + s) = exp(Mz s) z(t)`` exactly, for any s.  Samples on a uniform grid take one
+exponential per piece and a doubling scan (``Z[k:2k] = Z[0:k] Phi^k``, log2 K products).
+Every output is linear in z (``c . z``), so its time derivatives are ``c Mz z`` and
+``c Mz^2 z``: the extrema of an output are located between the samples on the
+continuous response (a cubic Hermite interpolant of the derivative through its exact
+values and slopes at two samples, whose error is O(dt^4)), and their values from a
+quintic Hermite interpolant (O(dt^6)).
+
+The lane change prescribes the steered axle's lateral acceleration ``a_s`` instead of
+the steer: ``a_s = C_s x + D_s delta + f_s`` (``D_s != 0``: direct feed-through), so
+``delta = (a_s - C_s x - f_s) / D_s`` and the model is driven by ``a_s`` through
+``A - b C_s / D_s`` (the inverse system).  Its eigenvalues are the zeros of the
+transfer function from the steer to ``a_s``; one in the right half plane makes the
+manoeuvre impossible for a driver to follow, and it is refused.
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> from lcvreport.analysis.manoeuvres import sine
+>>> r = response(load_preset("tractor_semitrailer"), 24.4444, sine(0.01, 0.4), t_end=10.0, dt=0.01)
+>>> r.time.shape, r["ay2"].shape
+((1001,), (1001,))
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.builder import check_speed, check_tire_scale, system_coefficients
+from ..model.vehicle import Vehicle
+from .discretize import augmented_state_matrix
+from .geometry import point_lateral_map, rear_end_weights
+from .manoeuvres import SteerInput
+
+#: output step of the measures' manoeuvres [s]
+MEASURE_DT_S = 0.002
+
+
+class ManoeuvreError(ValueError):
+    """A manoeuvre the vehicle cannot perform (e.g. an unstable inverse system)."""
+
+
+@dataclass
+class _Segment:
+    """One piece on the sample grid: the augmented matrix, its output rows, the samples."""
+
+    Mz: np.ndarray
+    C: np.ndarray                 # (signals, dim): every linear output from z
+    k0: int                       # first sample index in the piece
+    Z: np.ndarray                 # (samples, dim)
+    t0: float                     # the piece's start [s]
+    z_start: np.ndarray           # z at t0
+    z_end: np.ndarray | None = None
+    t1: float = math.inf
+
+
+@dataclass
+class ManoeuvreResponse:
+    """The exact response of one vehicle to one manoeuvre, sampled on a uniform grid.
+
+    Signals (SI) by name: ``delta`` [rad], the states (``v1``, ``r1``.., ``theta..``),
+    ``psi1`` [rad], ``Y1`` [m], ``ay1..ayN`` [m/s^2] (unit CGs), ``a_steer`` [m/s^2]
+    (the steered axle's centre), ``Y_<axle>`` [m] (every axle centre's global lateral
+    position, first order), ``y2..yN`` [m] (rear ends from the tractor axis).  Use
+    ``r["ay3"]``, :meth:`extrema`, :meth:`plot`, :meth:`to_rows`.
+    """
+
+    vehicle: Vehicle
+    speed_mps: float
+    steer: SteerInput
+    time: np.ndarray
+    signal_names: tuple
+    segments: list = field(repr=False)
+    _y_rows: np.ndarray = field(repr=False, default=None)
+    _H: np.ndarray = field(repr=False, default=None)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name == "time_s":
+            return self.time
+        if name.startswith("y") and name[1:].isdigit():
+            k = int(name[1:])
+            return self._rear_offsets()[:, k - 2]
+        j = self._index(name)
+        return np.concatenate([seg.Z @ seg.C[j] for seg in self.segments])
+
+    def _index(self, name: str) -> int:
+        try:
+            return self.signal_names.index(name)
+        except ValueError:
+            raise KeyError(f"no signal {name!r}; signals: {', '.join(self.signal_names)}, y2..") from None
+
+    def _rear_offsets(self) -> np.ndarray:
+        Theta = np.concatenate([seg.Z @ (seg.C[self._theta_rows].T) for seg in self.segments]) if \
+            self._theta_rows else np.zeros((self.time.size, 0))
+        return np.sin(Theta) @ rear_end_weights(self.vehicle).T
+
+    @property
+    def _theta_rows(self) -> list:
+        return [self.signal_names.index(n) for n in self.signal_names if n.startswith("Theta")]
+
+    def columns(self) -> list[str]:
+        """Output columns with units, in the order of :meth:`matrix`."""
+        out = ["time_s"]
+        for n in self.signal_names:
+            if n.startswith("Theta"):
+                continue
+            out.append(f"{n}_{_UNIT[_kind(n)]}")
+        out += [f"y{k}_m" for k in range(2, self.vehicle.n_units + 1)]
+        return out
+
+    def matrix(self) -> np.ndarray:
+        """Every signal at every sample, columns as :meth:`columns`."""
+        keep = [j for j, n in enumerate(self.signal_names) if not n.startswith("Theta")]
+        lin = np.concatenate([seg.Z @ seg.C[keep].T for seg in self.segments])
+        return np.column_stack([self.time, lin, self._rear_offsets()])
+
+    def to_rows(self, names: list[str] | None = None) -> list[dict]:
+        """Rows for a table or CSV (``time_s`` and the named signals, default all)."""
+        cols = self.columns()
+        M = self.matrix()
+        keep = list(range(len(cols))) if names is None else [0] + [
+            i for i, c in enumerate(cols) if c.rsplit("_", 1)[0] in names or c in names]
+        return [{cols[i]: float(row[i]) for i in keep} for row in M]
+
+    def extrema(self, name: str, t_from: float = 0.0, t_to: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
+        """Times [s] and values of the local extrema of signal ``name`` in ``[t_from,
+        t_to]`` on the continuous response, plus the values at the ends of that window
+        and at the input's breakpoints (where the derivative may jump)."""
+        j = self._index(name)
+        times, values = [], []
+        for seg in self.segments:
+            c = seg.C[j]
+            c1 = c @ seg.Mz
+            c2 = c1 @ seg.Mz
+            t = self.time[seg.k0:seg.k0 + len(seg.Z)]
+            if t.size == 0:
+                continue
+            y, d1, d2 = seg.Z @ c, seg.Z @ c1, seg.Z @ c2
+            dt = t[1] - t[0] if t.size > 1 else 0.0
+            change = np.flatnonzero(((d1[:-1] > 0) != (d1[1:] > 0)) | (d1[:-1] == 0))
+            change = change[(t[change + 1] >= t_from) & (t[change] <= t_to)]
+            for k in change:
+                tau = _hermite_root(d1[k], d2[k], d1[k + 1], d2[k + 1], dt)
+                tk = t[k] + tau * dt
+                if t_from <= tk <= t_to:
+                    times.append(tk)
+                    values.append(_quintic(y[k], d1[k], d2[k], y[k + 1], d1[k + 1], d2[k + 1], dt, tau))
+            # the ends of the window and the piece's own ends
+            for tb, zb in ((seg.t0, seg.z_start), (seg.t1, seg.z_end)):
+                if zb is not None and t_from <= tb <= t_to and math.isfinite(tb):
+                    times.append(tb)
+                    values.append(float(zb @ c))
+        for tb in (t_from, min(t_to, self.time[-1])):
+            if self.time[0] <= tb <= self.time[-1]:
+                times.append(tb)
+                values.append(self.value_at(name, tb))
+        order = np.argsort(times)
+        return np.asarray(times)[order], np.asarray(values)[order]
+
+    def value_at(self, name: str, t: float) -> float:
+        """The exact value of signal ``name`` at time ``t`` [s] (within the sampled span)."""
+        from scipy.linalg import expm
+        j = self._index(name)
+        if not self.time[0] <= t <= self.time[-1]:
+            raise ValueError(f"t = {t} s is outside the response [{self.time[0]}, {self.time[-1]}] s")
+        for seg in self.segments:
+            if seg.t0 <= t < seg.t1 or seg is self.segments[-1]:
+                ts = self.time[seg.k0:seg.k0 + len(seg.Z)]
+                k = int(np.searchsorted(ts, t, side="right")) - 1
+                t_base, z = (seg.t0, seg.z_start) if k < 0 else (ts[k], seg.Z[k])
+                return float(seg.C[j] @ expm(seg.Mz * (t - t_base)) @ z)
+        raise ValueError(f"t = {t} s is outside the response")  # pragma: no cover
+
+    def peak_abs(self, name: str, t_from: float = 0.0, t_to: float = math.inf) -> float:
+        """max |signal| over ``[t_from, t_to]`` on the continuous response."""
+        _t, v = self.extrema(name, t_from, t_to)
+        return float(np.abs(v).max())
+
+    def plot(self, signals: list[str] | None = None, ax=None):
+        """Plot signals against time (default: the steer and every unit's ay)."""
+        from ..report.plotting import plot_manoeuvre
+        return plot_manoeuvre(self, signals, ax)
+
+
+_UNIT = {"delta": "rad", "v": "m_per_s", "r": "rad_per_s", "theta": "rad", "psi": "rad", "Y": "m",
+         "ay": "m_per_s2", "a": "m_per_s2"}
+
+
+def _kind(name: str) -> str:
+    for k in ("delta", "theta", "psi", "ay", "a_steer", "Y", "v", "r"):
+        if name.startswith(k):
+            return "a" if k == "a_steer" else k
+    return "Y"
+
+
+def _hermite_root(f0, d0, f1, d1, h) -> float:
+    """The root in [0, 1] of the cubic Hermite interpolant of f (values f0, f1, slopes
+    d0, d1 per unit time over a step h), by bisection then Newton."""
+    d0, d1 = d0 * h, d1 * h
+    a = 2 * f0 - 2 * f1 + d0 + d1
+    b = -3 * f0 + 3 * f1 - 2 * d0 - d1
+    roots = np.roots([a, b, d0, f0]) if abs(a) + abs(b) > 0 else np.roots([d0, f0])
+    real = [r.real for r in roots if abs(r.imag) < 1e-9 and -1e-9 <= r.real <= 1 + 1e-9]
+    if not real:
+        return 0.0 if abs(f0) < abs(f1) else 1.0
+    return float(min(max(min(real, key=lambda r: abs(r - 0.5)), 0.0), 1.0))
+
+
+def _quintic(y0, d0, s0, y1, d1, s1, h, tau) -> float:
+    """Quintic Hermite interpolation of y at ``tau`` in [0, 1] from values, first and
+    second derivatives (per unit time) at both ends of a step h."""
+    d0, d1, s0, s1 = d0 * h, d1 * h, s0 * h * h, s1 * h * h
+    t, t2, t3, t4, t5 = tau, tau ** 2, tau ** 3, tau ** 4, tau ** 5
+    h00 = 1 - 10 * t3 + 15 * t4 - 6 * t5
+    h10 = t - 6 * t3 + 8 * t4 - 3 * t5
+    h20 = 0.5 * (t2 - 3 * t3 + 3 * t4 - t5)
+    h01 = 10 * t3 - 15 * t4 + 6 * t5
+    h11 = -4 * t3 + 7 * t4 - 3 * t5
+    h21 = 0.5 * (t3 - 2 * t4 + t5)
+    return float(h00 * y0 + h10 * d0 + h20 * s0 + h01 * y1 + h11 * d1 + h21 * s1)
+
+
+def _scan(Phi: np.ndarray, z0: np.ndarray, count: int) -> np.ndarray:
+    """``Z[k] = Phi^k z0`` for k < count by doubling (log2 count products)."""
+    Z = np.empty((count, z0.size))
+    Z[0] = z0
+    filled, P = 1, Phi
+    while filled < count:
+        take = min(filled, count - filled)
+        Z[filled:filled + take] = Z[:take] @ P.T
+        filled += take
+        if filled < count:
+            P = P @ P
+    return Z
+
+
+def steered_point(vehicle: Vehicle) -> float:
+    """Signed x [m] of the frontmost steered axle on the first unit."""
+    if not vehicle.steered_axles:
+        raise ManoeuvreError(f"{vehicle.name} has no steered axle: no steer input to apply")
+    return max(a.x_m for a in vehicle.steered_axles)
+
+
+def inverse_zeros(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+    """Eigenvalues of the inverse system from the steered axle's lateral acceleration to
+    the steer: the zeros of that transfer function [1/s]."""
+    A, b, Cs, Ds = _steer_axle_maps(vehicle, speed_mps, tire_scale)
+    return np.linalg.eigvals(A - np.outer(b, Cs) / Ds)
+
+
+def _steer_axle_maps(vehicle, speed_mps, tire_scale):
+    """x' = A x + b delta (+ G F); a_s = Cs x + Ds delta (+ Js G F)."""
+    co = system_coefficients(vehicle)
+    A, G = co.state_derivative_maps(speed_mps, tire_scale)
+    b = G @ co.B_delta(tire_scale)
+    xs = steered_point(vehicle)
+    Js = np.zeros(A.shape[0])
+    Js[0], Js[1] = 1.0, xs                      # v_s = v1 + x_s r1
+    Cs = Js @ A
+    Cs[1] += float(speed_mps)                   # a_s = v_s' + u r1
+    return A, b, Cs, float(Js @ b)
+
+
+def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float, dt: float,
+             F: np.ndarray | None = None, tire_scale: float = 1.0, t_start: float = 0.0,
+             state: np.ndarray | None = None) -> ManoeuvreResponse:
+    """The exact response from rest to ``steer`` (continuous) and the constant
+    generalized force ``F`` (residual sources, SI), sampled every ``dt`` to ``t_end``.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    speed_mps : float
+        Forward speed [m/s].
+    steer : SteerInput
+        See :mod:`lcvreport.analysis.manoeuvres`; a lane change is solved through the
+        inverse system.
+    t_end, dt : float
+        End time and output step [s]; ``dt`` must divide ``t_end``.
+    F : numpy.ndarray, optional
+        Constant generalized force (2N,), e.g. :func:`lcvreport.model.loads.residual_vector`.
+    tire_scale : float
+    t_start, state : float, numpy.ndarray, optional
+        Start later than 0 from ``state`` = [x, psi1, Y1] at ``t_start`` (a run in
+        chunks); the samples are then ``t_start + k dt``.
+
+    Raises
+    ------
+    ManoeuvreError
+        No steered axle; a lane change whose inverse system is unstable.
+    """
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    u = float(speed_mps)
+    span = t_end - t_start
+    n_steps = int(round(span / dt))
+    if n_steps < 1 or abs(n_steps * dt - span) > 1e-9 * max(span, 1.0):
+        raise ValueError(f"dt = {dt:g} s must divide t_end - t_start = {span:g} s")
+    co = system_coefficients(vehicle)
+    n = vehicle.n_states
+    nu = vehicle.n_units
+    m = n + 2
+    Aa, Ga = augmented_state_matrix(co, u, tire_scale)
+    F = np.zeros(n) if F is None else np.asarray(F, dtype=float)
+    gF = Ga @ F                                           # constant forcing of [x, psi1, Y1]
+    bd_x = Ga @ co.B_delta(tire_scale)
+    Ca, Da = co.acceleration_maps(u, tire_scale)
+    da = Da @ co.B_delta(tire_scale)
+    aF = Da @ F
+    lane = steer.prescribes_acceleration
+    if lane:
+        A_x, b, Cs, Ds = _steer_axle_maps(vehicle, u, tire_scale)
+        if abs(Ds) < 1e-12 * max(1.0, np.abs(Cs).max()):
+            raise ManoeuvreError("lane change: the steer does not reach the steered axle's lateral acceleration "
+                                 "directly; the inverse system does not exist")
+        zeros = np.linalg.eigvals(A_x - np.outer(b, Cs) / Ds)
+        if zeros.real.max() > 1e-9 * max(1.0, np.abs(zeros).max()):
+            worst = zeros[np.argmax(zeros.real)]
+            raise ManoeuvreError(f"lane change at {u * 3.6:.1f} km/h: the inverse system is unstable (a right-half-"
+                                 f"plane zero of the steer-to-axle-acceleration transfer function at "
+                                 f"{worst.real:.4g}{worst.imag:+.4g}j 1/s): no steer makes the steered axle "
+                                 "follow the path; the manoeuvre is refused")
+        fs = float(np.r_[1.0, steered_point(vehicle)] @ (co.state_derivative_maps(u, tire_scale)[1] @ F)[:2])
+    # signal rows over [x, psi1, Y1] (before the input's own part): states, psi1, Y1, ay, a_steer, Y_axles, Theta
+    names = list(vehicle.state_names) + ["psi1", "Y1"]
+    base = [np.eye(m)[i] for i in range(m)]
+    V_ay = [np.r_[Ca[i], 0.0, 0.0] for i in range(nu)]
+    names_ay = [f"ay{i + 1}" for i in range(nu)]
+    xs = steered_point(vehicle) if vehicle.steered_axles else None
+    Y_rows, Y_names = [], []
+    cum = np.zeros((nu - 1, m))
+    for k in range(nu - 1):
+        cum[k, nu + 1:nu + 2 + k] = 1.0
+    for i, unit in enumerate(vehicle.units):
+        for a in unit.axles:
+            c = point_lateral_map(vehicle, i, a.x_m)
+            row = c[2:] @ cum
+            row[n] += c[0]
+            row[n + 1] += c[1]
+            Y_rows.append(row)
+            Y_names.append(f"Y_{a.name}")
+    signal_names = tuple(["delta"] + names + names_ay + ["a_steer"] + Y_names +
+                         [f"Theta{k + 2}" for k in range(nu - 1)])
+    segments = []
+    t_grid = t_start + np.arange(n_steps + 1) * dt
+    z_state = np.zeros(m) if state is None else np.asarray(state, dtype=float)   # [x, psi1, Y1]
+    from scipy.linalg import expm
+    for piece in steer.pieces:
+        if piece.t0 > t_end + 1e-12:
+            break
+        if piece.t1 <= t_start + 1e-12 * max(1.0, t_start):
+            continue
+        if piece.t0 < t_start:                     # the piece began before this run: move its generator on
+            piece = type(piece)(t_start, piece.t1, piece.E, piece.h, expm(piece.E * (t_start - piece.t0)) @ piece.xi0)
+        p = piece.E.shape[0]
+        dim = m + p + 1
+        Mz = np.zeros((dim, dim))
+        if lane:
+            # x' = (A - b Cs/Ds) x + b (a_s - fs)/Ds + G F; psi1, Y1 as before
+            Mz[:m, :m] = Aa
+            Mz[:n, :n] = A_x - np.outer(b, Cs) / Ds
+            Mz[:n, m:m + p] = np.outer(b, piece.h) / Ds
+            Mz[:m, -1] = gF
+            Mz[:n, -1] -= b * fs / Ds
+        else:
+            Mz[:m, :m] = Aa
+            Mz[:m, m:m + p] = np.outer(bd_x, piece.h)
+            Mz[:m, -1] = gF
+        Mz[m:m + p, m:m + p] = piece.E
+        # output rows over z = [x, psi1, Y1, xi, 1]
+        if lane:
+            d_row = np.zeros(dim)
+            d_row[:n] = -Cs / Ds
+            d_row[m:m + p] = piece.h / Ds
+            d_row[-1] = -fs / Ds
+        else:
+            d_row = np.zeros(dim)
+            d_row[m:m + p] = piece.h
+        rows = [d_row]
+        for r in base:
+            rows.append(np.r_[r, np.zeros(p + 1)])
+        for i in range(nu):
+            row = np.r_[V_ay[i], np.zeros(p + 1)] + da[i] * d_row
+            row[-1] += aF[i]
+            rows.append(row)
+        if xs is not None:
+            # a_s = v1' + x_s r1' + u r1: from the state derivative
+            a_row = (np.r_[1.0, xs, np.zeros(dim - 2)]) @ Mz
+            a_row[1] += u
+            rows.append(a_row)
+        else:
+            rows.append(np.zeros(dim))
+        for r in Y_rows:
+            rows.append(np.r_[r, np.zeros(p + 1)])
+        for k in range(nu - 1):
+            rows.append(np.r_[cum[k], np.zeros(p + 1)])
+        C = np.array(rows)
+        z0 = np.r_[z_state, piece.xi0, 1.0]
+        t1 = min(piece.t1, math.inf)
+        ka = int(math.ceil((piece.t0 - t_start) / dt - 1e-9))
+        kb = n_steps if t1 > t_end + 1e-12 else int(math.ceil((t1 - t_start) / dt - 1e-9)) - 1
+        count = kb - ka + 1
+        if count > 0:
+            ta = t_start + ka * dt
+            za = z0 if abs(ta - piece.t0) <= 1e-12 * max(1.0, piece.t0) else expm(Mz * (ta - piece.t0)) @ z0
+            Phi = expm(Mz * dt)
+            Z = _scan(Phi, za, count)
+            z_end = expm(Mz * (t1 - (t_start + kb * dt))) @ Z[-1] \
+                if math.isfinite(t1) and t1 <= t_end + 1e-12 else None
+        else:
+            Z = np.zeros((0, dim))
+            z_end = expm(Mz * (t1 - piece.t0)) @ z0 if math.isfinite(t1) else None
+        segments.append(_Segment(Mz, C, ka, Z, piece.t0, z0, z_end, t1))
+        if z_end is None:
+            break
+        z_state = z_end[:m]
+    return ManoeuvreResponse(vehicle, u, steer, t_grid, signal_names, segments)
+
+
+def final_state(r: ManoeuvreResponse) -> np.ndarray:
+    """[x, psi1, Y1] at the last sample of ``r`` (to continue a run in chunks)."""
+    seg = r.segments[-1]
+    m = r.vehicle.n_states + 2
+    return seg.Z[-1, :m].copy()

@@ -1,0 +1,255 @@
+"""The field's yaw-plane measures beyond SPEC section 8 (SPEC section 12), at one speed.
+
+========================  ==========================================================
+``ra_peak``               max of RA(f) over 0.1-2 Hz, and where (f to 1e-6 Hz)
+``yaw_damping_coefficient``  PBS-style ratio method on a ``pulse:0.01:0.5`` steer
+``hsto_m``                high-speed transient offtracking in ``lane-change:0.15g:0.4``
+``ra_lane_change``        max|a_N| / max|a_s| in that lane change
+``hsso_m``                high-speed steady-state offtracking in a 393 m turn
+``steady_turn_delta_rad`` the steer angle of that turn
+========================  ==========================================================
+
+Each function takes the vehicle and the speed and returns a small named result; the
+null cases carry the reason (``why``).
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> ra = ra_peak(load_preset("tractor_semitrailer"), 24.4444)
+>>> 0.1 <= ra.frequency_hz <= 2.0
+True
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.builder import check_speed, check_tire_scale, system_coefficients
+from ..model.vehicle import Vehicle
+from .exact import ManoeuvreError, ManoeuvreResponse, response
+from .geometry import point_lateral_map
+from .manoeuvres import G_MPS2, lane_change, lane_change_offset_m, pulse
+from .measures import steer_to_acceleration
+
+#: the RA(f) search band [Hz]
+RA_BAND_HZ = (0.1, 2.0)
+#: the YDC pulse: amplitude [rad], duration [s]; the window after it [s]
+YDC_PULSE = (0.01, 0.5)
+YDC_WINDOW_S = 40.0
+#: amplitudes kept: at least this fraction of the joint's largest, the first this many
+YDC_MIN_FRACTION = 0.05
+YDC_MAX_AMPLITUDES = 6
+#: the lane change of HSTO: A0 [g], F [Hz], time after it [s]
+LANE_CHANGE = (0.15, 0.4)
+LANE_CHANGE_TAIL_S = 8.0
+#: the steady turn of HSSO: radius of the tractor's yaw rate u/R [m] (0.2 g at 100 km/h)
+HSSO_RADIUS_M = 393.0
+#: output step of the manoeuvres [s] (the YDC window is long and its extrema are located
+#: between samples by Hermite interpolation, whose error goes as the step to the 4th power)
+DT_S = 0.002
+YDC_DT_S = 0.005
+
+
+@dataclass(frozen=True)
+class RAPeak:
+    """Peak of the frequency-domain rearward amplification over :data:`RA_BAND_HZ`."""
+
+    value: float
+    frequency_hz: float
+
+
+def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RAPeak:
+    """max over 0.1-2 Hz of RA(f) = |G_N(j 2 pi f)| / |G_1(j 2 pi f)| and where it is
+    (a 0.005 Hz scan, then Brent's method on the best bracket to 1e-9 Hz).
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> p = ra_peak(load_preset("aucnat"), 24.4444)
+    >>> round(p.value, 3) > 5.0
+    True
+    """
+    from scipy.optimize import minimize_scalar
+    lo, hi = RA_BAND_HZ
+    f = np.linspace(lo, hi, 381)
+
+    def ra(x):
+        G = np.abs(steer_to_acceleration(vehicle, speed_mps, np.atleast_1d(x), tire_scale))
+        return G[..., -1] / G[..., 0]
+
+    values = ra(f)
+    k = int(np.argmax(values))
+    if k in (0, f.size - 1):
+        return RAPeak(float(values[k]), float(f[k]))
+    res = minimize_scalar(lambda x: -float(ra(x)[0]), bracket=(f[k - 1], f[k], f[k + 1]),
+                          bounds=None, method="brent", options={"xtol": 1e-12})
+    x = float(min(max(res.x, lo), hi))
+    return RAPeak(float(ra(x)[0]), x)
+
+
+@dataclass(frozen=True)
+class YawDamping:
+    """The ratio-method yaw damping of a pulse steer (SPEC section 12).
+
+    Attributes
+    ----------
+    value : float or None
+        The smallest per-joint value (None if no joint has two amplitudes).
+    per_joint : list of (float or None)
+        Each joint's mean ratio damping.
+    amplitudes : list of numpy.ndarray
+        The kept peak-to-peak amplitudes P_i of each joint [rad].
+    extrema : list of (numpy.ndarray, numpy.ndarray)
+        Times [s] and values [rad] of each joint's extrema after the pulse.
+    modal_least_damping_ratio : float or None
+        The modal zeta_min beside it (several modes of near frequency make the ratio
+        method read low).
+    response : ManoeuvreResponse
+    why : str
+        Why ``value`` is None.
+    """
+
+    value: float | None
+    per_joint: list
+    amplitudes: list
+    extrema: list
+    modal_least_damping_ratio: float | None
+    response: ManoeuvreResponse
+    why: str = ""
+
+
+def yaw_damping_coefficient(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> YawDamping:
+    """PBS-style yaw damping: the pulse ``pulse:0.01:0.5``; for each joint the extrema of
+    its articulation angle from the end of the pulse to 40 s after (zeros of theta',
+    located on the continuous response), their peak-to-peak amplitudes P_i = |A_(i+1) -
+    A_i|, the first six of those >= 5 % of the joint's largest; each consecutive pair
+    gives zeta = d / sqrt(pi^2 + d^2), d = ln(P_i / P_(i+1)); a joint's value is the mean
+    of its pairs; the coefficient the smallest over joints with two amplitudes or more.
+    """
+    from .measures import least_damping
+    A, D = YDC_PULSE
+    steer = pulse(A, D)
+    t_end = round((D + YDC_WINDOW_S) / YDC_DT_S) * YDC_DT_S
+    r = response(vehicle, speed_mps, steer, t_end, YDC_DT_S, tire_scale=tire_scale)
+    zeta_modal, _f = least_damping(vehicle, speed_mps, tire_scale)
+    if vehicle.n_units < 2:
+        return YawDamping(None, [], [], [], zeta_modal, r, "a single unit has no articulation joint")
+    per_joint, amps, ext = [], [], []
+    for name in vehicle.state_names[vehicle.n_units + 1:]:
+        t, v = r.extrema(name, D, D + YDC_WINDOW_S)
+        inner = (t > D + 1e-12) & (t < D + YDC_WINDOW_S - 1e-12)     # the window's ends are not extrema
+        t, v = t[inner], v[inner]
+        ext.append((t, v))
+        P = np.abs(np.diff(v))
+        if P.size:
+            P = P[P >= YDC_MIN_FRACTION * P.max()][:YDC_MAX_AMPLITUDES]
+        amps.append(P)
+        if P.size >= 2:
+            d = np.log(P[:-1] / P[1:])
+            per_joint.append(float(np.mean(d / np.sqrt(np.pi ** 2 + d ** 2))))
+        else:
+            per_joint.append(None)
+    defined = [z for z in per_joint if z is not None]
+    if not defined:
+        return YawDamping(None, per_joint, amps, ext, zeta_modal, r,
+                          "no joint oscillates with two amplitudes of at least 5 % of its largest after the pulse")
+    return YawDamping(min(defined), per_joint, amps, ext, zeta_modal, r)
+
+
+@dataclass(frozen=True)
+class LaneChangeMeasures:
+    """HSTO and the lane-change RA (SPEC section 12)."""
+
+    hsto_m: float
+    ra_lane_change: float
+    final_offset_m: float
+    response: ManoeuvreResponse
+    rear_axle: str
+    steered_axle: str
+
+
+def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
+                         accel_g: float = LANE_CHANGE[0], f_hz: float = LANE_CHANGE[1]) -> LaneChangeMeasures:
+    """The path-following lane change ``lane-change:0.15g:0.4``: the largest overshoot of
+    the last unit's rearmost axle beyond the steered axle's final offset A0/(2 pi F^2)
+    over 0 <= t <= 1/F + 8 s (0 if none), and max|a_N| / max|a_s|.
+
+    Raises
+    ------
+    ManoeuvreError
+        No steered axle, or an unstable inverse system.
+    """
+    steer = lane_change(accel_g * G_MPS2, f_hz)
+    t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
+    r = response(vehicle, speed_mps, steer, t_end, DT_S, tire_scale=tire_scale)
+    offset = lane_change_offset_m(steer)
+    rear = vehicle.units[-1].rearmost_axle.name
+    steered = max(vehicle.steered_axles, key=lambda a: a.x_m).name
+    sign = 1.0 if offset >= 0 else -1.0
+    _t, Y = r.extrema(f"Y_{rear}")
+    hsto = max(0.0, float(np.max(sign * (Y - offset))))
+    ra = r.peak_abs(f"ay{vehicle.n_units}") / r.peak_abs("a_steer")
+    return LaneChangeMeasures(hsto, float(ra), offset, r, rear, steered)
+
+
+@dataclass(frozen=True)
+class SteadyTurn:
+    """The steady turn of HSSO (SPEC section 12)."""
+
+    hsso_m: float
+    delta_rad: float
+    radius_m: float
+    state: np.ndarray
+    path_radius_m: dict
+
+
+def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
+                radius_m: float = HSSO_RADIUS_M) -> SteadyTurn:
+    """The steady turn with the tractor's yaw rate u/R: the steady state of
+    ``M x' = S x + b delta`` with r1 = u/R; every unit turns at Omega = u/R; a point at x on
+    unit i runs on the radius sqrt((x + v_i/Omega)^2 + (u/Omega)^2).  hsso_m = the radius
+    of the last unit's rearmost axle minus that of the frontmost steered axle (positive:
+    the rear tracks outside).
+
+    Raises
+    ------
+    ManoeuvreError
+        No steered axle.
+    """
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    if not vehicle.steered_axles:
+        raise ManoeuvreError(f"{vehicle.name} has no steered axle: no steer holds a turn")
+    co = system_coefficients(vehicle)
+    u = float(speed_mps)
+    S, b = co.S(u, tire_scale), co.B_delta(tire_scale)
+    n = vehicle.n_states
+    K = np.zeros((n + 1, n + 1))
+    K[:n, :n] = S
+    K[:n, n] = b
+    K[n, 1] = 1.0
+    omega = u / radius_m
+    rhs = np.zeros(n + 1)
+    rhs[n] = omega
+    sol = np.linalg.solve(K, rhs)
+    x, delta = sol[:n], float(sol[n])
+    v = co.velocity_map(u) @ x                 # CG lateral velocity of every unit
+
+    def radius(unit, xp):
+        return math.hypot(xp + v[unit] / omega, u / omega)
+
+    steered = max(vehicle.steered_axles, key=lambda a: a.x_m)
+    rear = vehicle.units[-1].rearmost_axle
+    paths = {a.name: radius(i, a.x_m) for i, a in zip(vehicle.axle_units, vehicle.axles)}
+    hsso = radius(vehicle.n_units - 1, rear.x_m) - radius(0, steered.x_m)
+    return SteadyTurn(float(hsso), delta, float(radius_m), x, paths)
+
+
+def point_path(vehicle: Vehicle, response: ManoeuvreResponse, unit: int, x_m: float) -> np.ndarray:
+    """Global lateral position [m] of any point of any unit in a manoeuvre (first order)."""
+    c = point_lateral_map(vehicle, unit, x_m)
+    Theta = np.column_stack([response[f"Theta{k + 2}"] for k in range(vehicle.n_units - 1)]) \
+        if vehicle.n_units > 1 else np.zeros((response.time.size, 0))
+    return c[0] * response["psi1"] + c[1] * response["Y1"] + Theta @ c[2:]

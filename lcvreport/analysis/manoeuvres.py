@@ -1,0 +1,262 @@
+"""Manoeuvres: steer inputs as continuous functions of time (SPEC section 11).
+
+Each steer input is a sequence of :class:`Piece` objects: on ``[t0, t1)`` the input is
+``h . xi(t)`` with ``xi' = E xi`` -- a constant, a line, a sinusoid -- so that the
+response to it is exact (the exponential of the state matrix augmented with ``E``,
+:mod:`lcvreport.analysis.exact`), not a sampled approximation.
+
+=====================  ================================================================
+``step:A``             delta = A for t >= 0
+``sine:A:F``           delta = A sin(2 pi F t) for 0 <= t <= 1/F, then 0 (single sine)
+``pulse:A:D``          delta = A sin(pi t / D) for 0 <= t <= D, then 0 (half sine)
+``csv:FILE``           columns ``time_s,delta_rad``, linear between samples, held after
+``lane-change:A0:F``   the steer that makes the steered axle's lateral acceleration
+                       A0 sin(2 pi F t) for 0 <= t <= 1/F, then 0 (A0 in m/s^2, or
+                       with a ``g`` suffix in g: ``0.15g``)
+=====================  ================================================================
+
+Examples
+--------
+>>> s = parse_steer("sine:0.01:0.4")
+>>> s.kind, s.end_s
+('sine', 2.5)
+>>> float(s.delta([0.625])[0])
+0.01
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..ranges import RANGES, RangeError
+
+#: standard gravity [m/s^2]
+G_MPS2 = 9.80665
+#: the largest number of rows of a steer table
+MAX_TABLE_ROWS = 1_000_000
+
+
+class SteerError(ValueError):
+    """A steer specification that cannot be used; the message names the part and the range."""
+
+
+@dataclass(frozen=True)
+class Piece:
+    """The input on ``[t0, t1)``: ``h . xi(t)`` with ``xi' = E xi`` and ``xi(t0) = xi0``."""
+
+    t0: float
+    t1: float
+    E: np.ndarray
+    h: np.ndarray
+    xi0: np.ndarray
+
+    def value(self, t) -> np.ndarray:
+        """The input at times ``t`` in the piece (closed form, no matrix exponential)."""
+        from scipy.linalg import expm
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        return np.array([self.h @ expm(self.E * (ti - self.t0)) @ self.xi0 for ti in t])
+
+
+def _constant(t0: float, t1: float, value: float) -> Piece:
+    return Piece(t0, t1, np.zeros((1, 1)), np.array([value]), np.array([1.0]))
+
+
+def _sinusoid(t0: float, t1: float, amplitude: float, omega: float, phase: float = 0.0) -> Piece:
+    """amplitude * sin(omega (t - t0) + phase) on [t0, t1)."""
+    E = np.array([[0.0, omega], [-omega, 0.0]])          # xi = [sin, cos](omega (t - t0) + phase)
+    return Piece(t0, t1, E, np.array([amplitude, 0.0]), np.array([math.sin(phase), math.cos(phase)]))
+
+
+def _line(t0: float, t1: float, value: float, slope: float) -> Piece:
+    """value + slope (t - t0) on [t0, t1)."""
+    E = np.array([[0.0, 0.0], [1.0, 0.0]])               # xi = [1, t - t0]
+    return Piece(t0, t1, E, np.array([value, slope]), np.array([1.0, 0.0]))
+
+
+@dataclass(frozen=True)
+class SteerInput:
+    """A steer input (or, for the lane change, a prescribed lateral acceleration).
+
+    Attributes
+    ----------
+    kind : str
+        ``step``, ``sine``, ``pulse``, ``csv`` or ``lane-change``.
+    pieces : tuple of Piece
+        The input in time order; the last one extends to infinity.
+    end_s : float
+        When the input ends (the sine's period, the pulse's duration, the last table
+        time; 0 for a step) [s].
+    spec : str
+        The text it was parsed from.
+    amplitude : float
+        A (rad) or A0 (m/s^2 for a lane change).
+    frequency_hz : float
+        F for sine and lane change, else NaN.
+    """
+
+    kind: str
+    pieces: tuple
+    end_s: float
+    spec: str
+    amplitude: float = 0.0
+    frequency_hz: float = float("nan")
+    prescribes_acceleration: bool = field(default=False)
+
+    def delta(self, t) -> np.ndarray:
+        """The input's value at times ``t`` [s] (rad; m/s^2 for a lane change)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        out = np.zeros(t.shape)
+        for p in self.pieces:
+            sel = (t >= p.t0) & (t < p.t1)
+            if sel.any():
+                out[sel] = p.value(t[sel])
+        return out
+
+
+def step(amplitude_rad: float) -> SteerInput:
+    """``delta = A`` for t >= 0."""
+    A = RANGES["steer_angle"].check(amplitude_rad, "step amplitude")
+    return SteerInput("step", (_constant(0.0, math.inf, A),), 0.0, f"step:{A:g}", A)
+
+
+def sine(amplitude_rad: float, frequency_hz: float) -> SteerInput:
+    """The single sine: ``delta = A sin(2 pi F t)`` for ``0 <= t <= 1/F``, then 0."""
+    A = RANGES["steer_angle"].check(amplitude_rad, "sine amplitude")
+    F = RANGES["frequency"].check(frequency_hz, "sine frequency")
+    T = 1.0 / F
+    return SteerInput("sine", (_sinusoid(0.0, T, A, 2 * math.pi * F), _constant(T, math.inf, 0.0)), T,
+                      f"sine:{A:g}:{F:g}", A, F)
+
+
+def pulse(amplitude_rad: float, duration_s: float) -> SteerInput:
+    """The half-sine pulse: ``delta = A sin(pi t / D)`` for ``0 <= t <= D``, then 0."""
+    A = RANGES["steer_angle"].check(amplitude_rad, "pulse amplitude")
+    D = RANGES["pulse_duration"].check(duration_s, "pulse duration")
+    return SteerInput("pulse", (_sinusoid(0.0, D, A, math.pi / D), _constant(D, math.inf, 0.0)), D,
+                      f"pulse:{A:g}:{D:g}", A)
+
+
+def table(time_s, delta_rad, source: str = "table") -> SteerInput:
+    """Steer angle from samples: linear between them, held after the last (0 before the
+    first, which must be at t = 0 or later).
+
+    Raises
+    ------
+    SteerError
+        Times not strictly increasing, non-finite values, or angles out of range.
+    """
+    t = np.asarray(time_s, dtype=float)
+    d = np.asarray(delta_rad, dtype=float)
+    if t.ndim != 1 or t.size < 1 or t.shape != d.shape:
+        raise SteerError(f"{source}: needs one time_s and one delta_rad per row, at least one row")
+    if t.size > MAX_TABLE_ROWS:
+        raise SteerError(f"{source}: {t.size} rows; at most {MAX_TABLE_ROWS}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(d))):
+        k = int(np.flatnonzero(~(np.isfinite(t) & np.isfinite(d)))[0])
+        raise SteerError(f"{source}: row {k + 1} is not finite (time_s={t[k]!r}, delta_rad={d[k]!r})")
+    if t[0] < 0:
+        raise SteerError(f"{source}: time_s must start at 0 or later, got {t[0]:g}")
+    if np.any(np.diff(t) <= 0):
+        k = int(np.flatnonzero(np.diff(t) <= 0)[0])
+        raise SteerError(f"{source}: time_s must increase strictly; row {k + 2} ({t[k + 1]:g} s) does not come "
+                         f"after row {k + 1} ({t[k]:g} s)")
+    r = RANGES["steer_angle"]
+    if not np.all((d >= r.low) & (d <= r.high)):
+        k = int(np.flatnonzero(~((d >= r.low) & (d <= r.high)))[0])
+        raise SteerError(f"{source}: delta_rad in row {k + 1} must be in {r.text()}, got {d[k]:g}")
+    pieces = []
+    if t[0] > 0:
+        pieces.append(_constant(0.0, float(t[0]), 0.0))
+    for k in range(t.size - 1):
+        pieces.append(_line(float(t[k]), float(t[k + 1]), float(d[k]), float((d[k + 1] - d[k]) / (t[k + 1] - t[k]))))
+    pieces.append(_constant(float(t[-1]), math.inf, float(d[-1])))
+    return SteerInput("csv", tuple(pieces), float(t[-1]), f"csv:{source}", float(np.abs(d).max()))
+
+
+def read_table(path: str | Path) -> SteerInput:
+    """A steer table from a CSV file with the header ``time_s,delta_rad``."""
+    path = Path(path)
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SteerError(f"csv:{path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") from None
+    if not rows or [c.strip() for c in rows[0]] != ["time_s", "delta_rad"]:
+        raise SteerError(f"csv:{path}: the first line must be the header time_s,delta_rad")
+    t, d = [], []
+    for k, row in enumerate(rows[1:], start=2):
+        if not row or all(not c.strip() for c in row):
+            continue
+        if len(row) != 2:
+            raise SteerError(f"csv:{path}: line {k} must have two columns, got {len(row)}")
+        try:
+            t.append(float(row[0]))
+            d.append(float(row[1]))
+        except ValueError:
+            raise SteerError(f"csv:{path}: line {k} is not two numbers: {','.join(row)!r}") from None
+    return table(t, d, source=str(path))
+
+
+def lane_change(accel_mps2: float, frequency_hz: float) -> SteerInput:
+    """The path-following lane change: the steered axle's lateral acceleration is
+    ``A0 sin(2 pi F t)`` for ``0 <= t <= 1/F``, then 0; the axle ends on a straight line
+    offset by ``A0 / (2 pi F^2)`` [m].  The steer is found from the inverse system
+    (:func:`lcvreport.analysis.exact.response`)."""
+    A0 = RANGES["lateral_acceleration"].check(accel_mps2, "lane-change acceleration")
+    F = RANGES["frequency"].check(frequency_hz, "lane-change frequency")
+    T = 1.0 / F
+    return SteerInput("lane-change", (_sinusoid(0.0, T, A0, 2 * math.pi * F), _constant(T, math.inf, 0.0)), T,
+                      f"lane-change:{A0:g}:{F:g}", A0, F, prescribes_acceleration=True)
+
+
+def lane_change_offset_m(steer: SteerInput) -> float:
+    """The final lateral offset of the steered axle in a lane change, A0 / (2 pi F^2) [m]."""
+    return steer.amplitude / (2 * math.pi * steer.frequency_hz ** 2)
+
+
+def _number(text: str, what: str, spec: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise SteerError(f"steer {spec!r}: {what} must be a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise SteerError(f"steer {spec!r}: {what} must be finite, got {text!r}")
+    return value
+
+
+def parse_steer(spec: str) -> SteerInput:
+    """A steer input from its text (the table in the module docstring).
+
+    Raises
+    ------
+    SteerError
+        Naming the part of ``spec`` that is wrong and what is valid.
+    """
+    kinds = "step:A, sine:A:F, pulse:A:D, csv:FILE, lane-change:A0:F"
+    kind, _, rest = spec.partition(":")
+    parts = rest.split(":") if rest else []
+    try:
+        if kind == "csv":
+            if not rest:
+                raise SteerError(f"steer {spec!r}: csv needs a file, csv:FILE")
+            return read_table(rest)
+        expected = {"step": 1, "sine": 2, "pulse": 2, "lane-change": 2}
+        if kind not in expected:
+            raise SteerError(f"steer {spec!r}: unknown kind {kind!r}; valid: {kinds}")
+        if len(parts) != expected[kind]:
+            raise SteerError(f"steer {spec!r}: {kind} takes {expected[kind]} number(s); valid: {kinds}")
+        if kind == "step":
+            return step(_number(parts[0], "A [rad]", spec))
+        if kind == "sine":
+            return sine(_number(parts[0], "A [rad]", spec), _number(parts[1], "F [Hz]", spec))
+        if kind == "pulse":
+            return pulse(_number(parts[0], "A [rad]", spec), _number(parts[1], "D [s]", spec))
+        a = parts[0].strip()
+        A0 = _number(a[:-1], "A0 [g]", spec) * G_MPS2 if a.lower().endswith("g") else _number(a, "A0 [m/s^2]", spec)
+        return lane_change(A0, _number(parts[1], "F [Hz]", spec))
+    except RangeError as exc:
+        raise SteerError(f"steer {spec!r}: {exc}") from None
