@@ -407,7 +407,10 @@ def test_ctrl_c_ends_a_report_with_one_line_and_leaves_nothing(tmp_path):
     out = tmp_path / "r"
     proc = subprocess.Popen([sys.executable, "-m", "lcvreport.cli", "report", "--preset", "aucnat", "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    time.sleep(6.0)                                   # inside the notebook
+    deadline = time.time() + 120
+    while not list(tmp_path.glob(".r.writing-*/notebooks")) and time.time() < deadline:
+        time.sleep(0.05)                              # the report has started writing aside
+    time.sleep(1.0)                                   # inside the notebook
     os.killpg(proc.pid, signal.SIGINT)                # what Ctrl-C sends: the whole foreground group
     stdout, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 130, (proc.returncode, stderr[-3000:])

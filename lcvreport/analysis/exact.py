@@ -147,14 +147,17 @@ class ManoeuvreResponse:
                 continue
             y, d1, d2 = seg.Z @ c, seg.Z @ c1, seg.Z @ c2
             dt = t[1] - t[0] if t.size > 1 else 0.0
-            change = np.flatnonzero(((d1[:-1] > 0) != (d1[1:] > 0)) | (d1[:-1] == 0))
+            # a sign change of the derivative, or a zero of it at a sample (not a flat stretch)
+            change = np.flatnonzero(((d1[:-1] > 0) != (d1[1:] > 0)) & ((d1[:-1] != 0) | (d1[1:] != 0)))
             change = change[(t[change + 1] >= t_from) & (t[change] <= t_to)]
-            for k in change:
-                tau = _hermite_root(d1[k], d2[k], d1[k + 1], d2[k + 1], dt)
+            if change.size:
+                k, k1 = change, change + 1
+                tau = _hermite_roots(d1[k], d2[k], d1[k1], d2[k1], dt)
                 tk = t[k] + tau * dt
-                if t_from <= tk <= t_to:
-                    times.append(tk)
-                    values.append(_quintic(y[k], d1[k], d2[k], y[k + 1], d1[k + 1], d2[k + 1], dt, tau))
+                val = _quintic(y[k], d1[k], d2[k], y[k1], d1[k1], d2[k1], dt, tau)
+                keep = (tk >= t_from) & (tk <= t_to)
+                times.extend(tk[keep].tolist())
+                values.extend(val[keep].tolist())
             # the ends of the window and the piece's own ends
             for tb, zb in ((seg.t0, seg.z_start), (seg.t1, seg.z_end)):
                 if zb is not None and t_from <= tb <= t_to and math.isfinite(tb):
@@ -203,17 +206,38 @@ def _kind(name: str) -> str:
     return "Y"
 
 
-def _hermite_root(f0, d0, f1, d1, h) -> float:
-    """The root in [0, 1] of the cubic Hermite interpolant of f (values f0, f1, slopes
-    d0, d1 per unit time over a step h), by bisection then Newton."""
+def _hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
+    """The roots in [0, 1] of cubic Hermite interpolants of f (values f0, f1 of opposite
+    sign, slopes d0, d1 per unit time over a step h), vectorized: Newton from the secant
+    root, kept inside a bracket that shrinks with every iterate (safeguarded)."""
+    f0, d0, f1, d1 = (np.asarray(a, dtype=float) for a in (f0, d0, f1, d1))
     d0, d1 = d0 * h, d1 * h
     a = 2 * f0 - 2 * f1 + d0 + d1
     b = -3 * f0 + 3 * f1 - 2 * d0 - d1
-    roots = np.roots([a, b, d0, f0]) if abs(a) + abs(b) > 0 else np.roots([d0, f0])
-    real = [r.real for r in roots if abs(r.imag) < 1e-9 and -1e-9 <= r.real <= 1 + 1e-9]
-    if not real:
-        return 0.0 if abs(f0) < abs(f1) else 1.0
-    return float(min(max(min(real, key=lambda r: abs(r - 0.5)), 0.0), 1.0))
+    lo, hi = np.zeros(f0.shape), np.ones(f0.shape)
+    denom = f0 - f1
+    tau = np.where(denom != 0, f0 / np.where(denom != 0, denom, 1.0), 0.0).clip(0.0, 1.0)
+    s0 = np.sign(f0)
+    tau = np.where(f0 == 0, 0.0, np.where(f1 == 0, 1.0, tau))
+    active = (f0 != 0) & (f1 != 0)
+    if not active.any():
+        return tau
+    for _ in range(40):
+        p = ((a * tau + b) * tau + d0) * tau + f0
+        dp = (3 * a * tau + 2 * b) * tau + d0
+        same = np.sign(p) == s0
+        lo = np.where(same, tau, lo)
+        hi = np.where(same, hi, tau)
+        step = np.where(dp != 0, p / np.where(dp != 0, dp, 1.0), 0.0)
+        new = tau - step
+        bad = (new < lo) | (new > hi) | ~np.isfinite(new)
+        new = np.where(bad, 0.5 * (lo + hi), new)
+        new = np.where(active, new, tau)
+        if np.all(np.abs(new - tau) <= 1e-13):
+            tau = new
+            break
+        tau = new
+    return tau
 
 
 def _quintic(y0, d0, s0, y1, d1, s1, h, tau) -> float:
@@ -227,7 +251,7 @@ def _quintic(y0, d0, s0, y1, d1, s1, h, tau) -> float:
     h01 = 10 * t3 - 15 * t4 + 6 * t5
     h11 = -4 * t3 + 7 * t4 - 3 * t5
     h21 = 0.5 * (t3 - 2 * t4 + t5)
-    return float(h00 * y0 + h10 * d0 + h20 * s0 + h01 * y1 + h11 * d1 + h21 * s1)
+    return h00 * y0 + h10 * d0 + h20 * s0 + h01 * y1 + h11 * d1 + h21 * s1
 
 
 def _scan(Phi: np.ndarray, z0: np.ndarray, count: int) -> np.ndarray:

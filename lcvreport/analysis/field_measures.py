@@ -120,6 +120,31 @@ class YawDamping:
     why: str = ""
 
 
+def ratio_damping(extrema_values) -> tuple[float | None, np.ndarray]:
+    """The ratio method on a signal's successive extrema (time order): the peak-to-peak
+    amplitudes P_i = |A_(i+1) - A_i|, the first six of those >= 5 % of the largest, and
+    the mean over consecutive pairs of zeta = d / sqrt(pi^2 + d^2), d = ln(P_i/P_(i+1));
+    None when fewer than two amplitudes are kept.  For one damped mode
+    ``exp(sigma t) sin(omega t)`` it is exactly -sigma / |lambda|.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> lam = -0.3 + 2.0j                     # extrema of exp(-0.3 t) sin(2 t + phi) are pi/2 apart
+    >>> A = np.exp(lam.real * np.pi / 2 * np.arange(8)) * (-1.0) ** np.arange(8)
+    >>> round(ratio_damping(A)[0], 12) == round(-lam.real / abs(lam), 12)
+    True
+    """
+    v = np.asarray(extrema_values, dtype=float)
+    P = np.abs(np.diff(v))
+    if P.size:
+        P = P[P >= YDC_MIN_FRACTION * P.max()][:YDC_MAX_AMPLITUDES]
+    if P.size < 2:
+        return None, P
+    d = np.log(P[:-1] / P[1:])
+    return float(np.mean(d / np.sqrt(np.pi ** 2 + d ** 2))), P
+
+
 def yaw_damping_coefficient(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> YawDamping:
     """PBS-style yaw damping: the pulse ``pulse:0.01:0.5``; for each joint the extrema of
     its articulation angle from the end of the pulse to 40 s after (zeros of theta',
@@ -142,15 +167,9 @@ def yaw_damping_coefficient(vehicle: Vehicle, speed_mps: float, tire_scale: floa
         inner = (t > D + 1e-12) & (t < D + YDC_WINDOW_S - 1e-12)     # the window's ends are not extrema
         t, v = t[inner], v[inner]
         ext.append((t, v))
-        P = np.abs(np.diff(v))
-        if P.size:
-            P = P[P >= YDC_MIN_FRACTION * P.max()][:YDC_MAX_AMPLITUDES]
+        zeta, P = ratio_damping(v)
         amps.append(P)
-        if P.size >= 2:
-            d = np.log(P[:-1] / P[1:])
-            per_joint.append(float(np.mean(d / np.sqrt(np.pi ** 2 + d ** 2))))
-        else:
-            per_joint.append(None)
+        per_joint.append(zeta)
     defined = [z for z in per_joint if z is not None]
     if not defined:
         return YawDamping(None, per_joint, amps, ext, zeta_modal, r,

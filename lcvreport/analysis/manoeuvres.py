@@ -55,10 +55,20 @@ class Piece:
     xi0: np.ndarray
 
     def value(self, t) -> np.ndarray:
-        """The input at times ``t`` in the piece (closed form, no matrix exponential)."""
+        """The input at times ``t`` in the piece (closed form for constants, lines and
+        sinusoids; the exponential otherwise)."""
+        tau = np.atleast_1d(np.asarray(t, dtype=float)) - self.t0
+        E, h, x0 = self.E, self.h, self.xi0
+        if E.shape == (1, 1) and E[0, 0] == 0.0:
+            return np.full(tau.shape, h[0] * x0[0])
+        if E.shape == (2, 2) and E[0, 0] == E[0, 1] == E[1, 1] == 0.0 and E[1, 0] == 1.0:
+            return h[0] * x0[0] + h[1] * (x0[1] + tau * x0[0])
+        if E.shape == (2, 2) and E[0, 0] == E[1, 1] == 0.0 and E[0, 1] == -E[1, 0]:
+            w = E[0, 1]
+            c, s = np.cos(w * tau), np.sin(w * tau)
+            return h[0] * (x0[0] * c + x0[1] * s) + h[1] * (x0[1] * c - x0[0] * s)
         from scipy.linalg import expm
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        return np.array([self.h @ expm(self.E * (ti - self.t0)) @ self.xi0 for ti in t])
+        return np.array([h @ expm(E * ti) @ x0 for ti in tau])
 
 
 def _constant(t0: float, t1: float, value: float) -> Piece:
