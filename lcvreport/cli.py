@@ -174,6 +174,7 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--out", required=True, metavar="DIR", help="output folder")
     rep.add_argument("--no-pdf", action="store_true", help="HTML only")
     rep.add_argument("--paper", default="letter", choices=("letter", "a4"), help="paper of the PDF (default letter)")
+    rep.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
     sub.add_parser("presets", help="list the presets").add_argument("--json", action="store_true")
     return p
 
@@ -590,6 +591,19 @@ def _cmd_report(args, out: _Out) -> int:
             one_percent_rule(v, units)
         except ValueError as exc:
             raise UsageError(f"argument --load: {exc}") from None
+    src = _sources(args, v)
+    try:
+        src.vector(v)
+    except (KeyError, RangeError) as exc:
+        raise UsageError(f"argument: {exc.args[0]}") from None
+    residuals = {"P_N": src.loads.P_N, "T_Nm": src.loads.T_Nm, "misalignment_rad": src.misalignment_rad,
+                 "crossfall_percent": src.crossfall_percent} if src else None
+    if args.criteria is not None:
+        from .analysis.criteria import CriteriaError, load_criteria
+        try:
+            load_criteria(args.criteria)
+        except CriteriaError as exc:
+            raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
     text = None
     if args.vehicle is not None:               # the user's file as written, comments and all
         from .model.vehicle_file import read_vehicle_text
@@ -598,7 +612,8 @@ def _cmd_report(args, out: _Out) -> int:
     try:
         res = build_assessment(v, args.out, speed_mps=speed, load_units=units, pdf=not args.no_pdf,
                                progress=lambda text: print(f"lcv report: {text}", file=sys.stderr, flush=True),
-                               source=args.vehicle or f"preset {args.preset}", vehicle_text=text, paper=args.paper)
+                               source=args.vehicle or f"preset {args.preset}", vehicle_text=text, paper=args.paper,
+                               residuals=residuals, criteria_file=args.criteria)
     except OutputFolderError as exc:
         raise UsageError(f"argument {exc}") from None
     except ReportError as exc:
@@ -665,7 +680,17 @@ def _silence_stdout() -> None:
 
 def main() -> None:
     """Console entry point."""
-    sys.exit(run())
+    status = run()
+    if status == EXIT_INTERRUPTED:
+        # leave at once: what Ctrl-C cut short (a notebook kernel's event loop) would
+        # otherwise print its own tracebacks while the interpreter shuts down
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(status)
+    sys.exit(status)
 
 
 if __name__ == "__main__":

@@ -472,3 +472,23 @@ def test_a4_paper(tmp_path):
     assert p.returncode == 0, p.stderr[-3000:]
     info = subprocess.run(["pdfinfo", str(out / "report.pdf")], capture_output=True, text=True).stdout
     assert "595.276 x 841.89 pts (A4)" in info or "595.28 x 841.89" in info, info
+
+
+def test_the_assessment_shows_the_manoeuvres_the_residual_sources_and_the_verdicts(tmp_path):
+    out = tmp_path / "r"
+    p = _lcv("report", "--preset", "tractor_semitrailer", "--misalignment", "21=0.002", "--crossfall-percent", "2",
+             "--criteria", str(ROOT / "examples" / "criteria" / "example_limits.toml"), "--no-pdf", "--out", str(out))
+    assert p.returncode == 0, p.stderr[-3000:]
+    data = out / "data"
+    for name in ("figure_10.csv", "figure_11.csv", "table_4a.csv", "table_5a.csv"):
+        assert (data / name).stat().st_size > 0, name
+    verdicts = list(csv.DictReader(open(data / "table_4a.csv", encoding="utf-8")))
+    assert {r["measure"] for r in verdicts} >= {"ra_single_sine", "hsto_m"}
+    assert all(r["verdict"] in ("pass", "fail", "not computed") for r in verdicts)
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "misalignment 21 0.002 rad; crossfall 2 %" in html and "HSTO" in html
+    measures = {r["json_key"]: r["value"] for r in csv.DictReader(open(data / "table_4.csv", encoding="utf-8"))}
+    doc = json.loads(_lcv("measures", "--preset", "tractor_semitrailer", "--speed-kph", "88", "--misalignment",
+                          "21=0.002", "--crossfall-percent", "2", "--json").stdout)
+    assert float(measures["trim.offtracking_m"]) == pytest.approx(doc["trim"]["offtracking_m"], rel=1e-12)
+    assert float(measures["hsto_m"]) == pytest.approx(doc["hsto_m"], rel=1e-12)

@@ -42,15 +42,26 @@ class Assessment:
     fast: bool = False
     source: str = ""
     _cache: dict = field(default_factory=dict, repr=False)
+    sources: object = None          # ResidualSources beyond the 1 % rule (SPEC 11)
+    criteria: object = None         # Criteria to judge the measures by
 
     @classmethod
     def load(cls, preset: str | None = None, vehicle_file: str | None = None, speed_kph: float = 88.0,
-             load_units=None, fast: bool = False, source: str | None = None) -> "Assessment":
+             load_units=None, fast: bool = False, source: str | None = None, residuals: dict | None = None,
+             criteria_file: str | None = None) -> "Assessment":
         """From a preset name or a vehicle file; ``source`` names it for captions (default:
-        the preset or the file's path)."""
+        the preset or the file's path); ``residuals`` (``P_N``, ``T_Nm``,
+        ``misalignment_rad`` by axle, ``crossfall_percent``) and a criteria file optional."""
+        from ..analysis.criteria import load_criteria
+        from ..model.loads import ResidualLoads, ResidualSources
         vehicle = load_preset(preset) if preset is not None else load_vehicle(vehicle_file)
+        res = residuals or {}
+        sources = ResidualSources(ResidualLoads(dict(res.get("P_N", {})), dict(res.get("T_Nm", {}))),
+                                  dict(res.get("misalignment_rad", {})), float(res.get("crossfall_percent", 0.0)))
         return cls(vehicle, float(speed_kph), tuple(load_units or ()), fast,
-                   source or (f"preset {preset}" if preset is not None else str(vehicle_file)))
+                   source or (f"preset {preset}" if preset is not None else str(vehicle_file)),
+                   sources=sources if sources else None,
+                   criteria=load_criteria(criteria_file) if criteria_file else None)
 
     @property
     def speed_mps(self) -> float:
@@ -154,8 +165,10 @@ class Assessment:
         f = self.frequencies_hz
         G = np.abs(measures.steer_to_acceleration(self.vehicle, self.speed_mps, f))
         curves = [(f"RA = |G_{self.vehicle.n_units}| / |G_1|", G[:, -1] / G[:, 0])]
+        m = self.measures
         fig = plotting.fig_frequency(f, curves, "rearward amplification [-]",
-                                     f"Rearward amplification of {self.at}", measures.RA_FREQUENCY_HZ)
+                                     f"Rearward amplification of {self.at}", measures.RA_FREQUENCY_HZ,
+                                     peak=(m.ra_peak_frequency_hz, m.ra_peak))
         fig.lcv_data = [{"frequency_hz": fi, "rearward_amplification": ra} for fi, ra in zip(f, G[:, -1] / G[:, 0])]
         return fig
 
@@ -185,7 +198,62 @@ class Assessment:
     # ------------------------------------------------------------------ measures and conicity
     @cached_property
     def measures(self) -> measures.MeasureSet:
-        return measures.measure_set(self.vehicle, self.speed_mps, load_units=list(self.load_units) or None)
+        return measures.measure_set(self.vehicle, self.speed_mps, load_units=list(self.load_units) or None,
+                                    sources=self.sources)
+
+    # ------------------------------------------------------------------ manoeuvres (SPEC 11-12)
+    @cached_property
+    def lane_change(self):
+        from ..analysis.field_measures import lane_change_measures
+        return lane_change_measures(self.vehicle, self.speed_mps)
+
+    def fig_lane_change(self):
+        lc = self.lane_change
+        fig = plotting.fig_lane_change(lc, f"Lane change 0.15 g at 0.4 Hz of {self.at}")
+        r = lc.response
+        fig.lcv_data = [{"time_s": t, "steer_angle_rad": d, f"Y_{lc.steered_axle}_m": a, f"Y_{lc.rear_axle}_m": b,
+                         "a_steer_m_per_s2": c, f"ay{self.vehicle.n_units}_m_per_s2": e}
+                        for t, d, a, b, c, e in zip(r.time, r["delta"], r[f"Y_{lc.steered_axle}"],
+                                                    r[f"Y_{lc.rear_axle}"], r["a_steer"],
+                                                    r[f"ay{self.vehicle.n_units}"])]
+        return fig
+
+    @cached_property
+    def yaw_damping(self):
+        from ..analysis.field_measures import yaw_damping_coefficient
+        return yaw_damping_coefficient(self.vehicle, self.speed_mps)
+
+    def fig_pulse(self):
+        names = list(self.vehicle.state_names[self.vehicle.n_units + 1:])
+        y = self.yaw_damping
+        fig = plotting.fig_pulse(y, names, f"Pulse steer 0.01 rad, 0.5 s: articulation of {self.at} (dots: the "
+                                           "extrema the ratio method uses)")
+        rows = []
+        for name, (t, v), zeta in zip(names, y.extrema, y.per_joint):
+            for ti, vi in zip(t, v):
+                rows.append({"joint": name, "time_s": ti, "extremum_rad": vi,
+                             "joint_ratio_damping": "" if zeta is None else zeta})
+        fig.lcv_data = rows
+        return fig
+
+    @cached_property
+    def steady_turn(self):
+        from ..analysis.field_measures import steady_turn
+        return steady_turn(self.vehicle, self.speed_mps)
+
+    def turn_rows(self) -> list[dict]:
+        """Path radius of every axle in the 393 m turn, relative to the steered axle's."""
+        t = self.steady_turn
+        ref = t.path_radius_m[max(self.vehicle.steered_axles, key=lambda a: a.x_m).name]
+        return [{"axle": a.name, "unit": self.vehicle.units[i].name, "path_radius_m": t.path_radius_m[a.name],
+                 "outside_the_steered_axle_m": t.path_radius_m[a.name] - ref}
+                for i, a in zip(self.vehicle.axle_units, self.vehicle.axles)]
+
+    def verdict_rows(self) -> list[dict]:
+        from ..analysis.criteria import judge
+        doc = self.measures.to_dict()
+        return [{"measure": k, "value": "" if v["value"] is None else v["value"], "limit": v["limit"],
+                 "verdict": v["verdict"], "source": v["source"]} for k, v in judge(self.criteria, doc).items()]
 
     @cached_property
     def sensitivity(self) -> list[measures.AxleSensitivity]:

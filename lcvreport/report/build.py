@@ -111,6 +111,22 @@ def _load_units(name, value, ctx):
                           f"got {value!r}")
 
 
+def _residuals(name, value, ctx):
+    if value is None:
+        return
+    allowed = {"P_N", "T_Nm", "misalignment_rad", "crossfall_percent"}
+    if not isinstance(value, dict) or set(value) - allowed:
+        raise ReportError(f"parameter {name} must be None or a dict with keys {', '.join(sorted(allowed))}, "
+                          f"got {value!r}")
+    from ..model.loads import ResidualLoads, ResidualSources
+    try:
+        ResidualSources(ResidualLoads(dict(value.get("P_N", {})), dict(value.get("T_Nm", {}))),
+                        dict(value.get("misalignment_rad", {})),
+                        float(value.get("crossfall_percent", 0.0))).vector(ctx["vehicle"])
+    except (KeyError, ValueError, TypeError) as exc:
+        raise ReportError(f"parameter {name}: {exc.args[0] if exc.args else exc}") from None
+
+
 def _text_or_none(name, value, _ctx):
     if value is not None and not isinstance(value, str):
         raise ReportError(f"parameter {name} must be text or None, got {value!r}")
@@ -149,7 +165,7 @@ NOTEBOOKS = (
 #: the assessment report's notebook
 ASSESSMENT = NotebookSpec("assessment", "assessment", "Yaw-plane assessment",
                           {**_COMMON, "preset": lambda n, v, c: None, "vehicle_file": _vehicle_file,
-                           "source": _text_or_none,
+                           "source": _text_or_none, "residuals": _residuals, "criteria_file": _text_or_none,
                            "speed_kph": _speed(1 / MPS_PER_KPH, "km/h"), "load_units": _load_units})
 SPECS = {s.stem: s for s in NOTEBOOKS + (ASSESSMENT,)}
 
@@ -496,7 +512,8 @@ def _folder_state(out: Path) -> tuple:
 
 def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = None, load_units=None,
                      pdf: bool = True, progress: Callable[[str], None] | None = None, fast: bool = False,
-                     source: str = "", vehicle_text: str | None = None, paper: str = "letter") -> dict:
+                     source: str = "", vehicle_text: str | None = None, paper: str = "letter",
+                     residuals: dict | None = None, criteria_file: str | None = None) -> dict:
     """The assessment report of ``vehicle`` (SPEC section 10) into ``out_dir``.
 
     The report is written into a hidden folder beside ``out_dir`` and moved into place
@@ -526,6 +543,11 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         vehicle written out.
     paper : {"letter", "a4"}
         Paper size of the PDF.
+    residuals : dict, optional
+        Residual sources beyond the 1 % rule: ``P_N``, ``T_Nm``, ``misalignment_rad`` (by
+        axle), ``crossfall_percent``.
+    criteria_file : str, optional
+        Limits to judge the measures by (a verdict table).
 
     Returns
     -------
@@ -553,7 +575,8 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
             dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name}).")
         vehicle_file.write_text(text, encoding="utf-8")
         params = {"fast": bool(fast), "data_dir": str(data_dir), "preset": None, "vehicle_file": str(vehicle_file),
-                  "source": source or None, "speed_kph": float(speed_kph),
+                  "source": source or None, "speed_kph": float(speed_kph), "residuals": residuals,
+                  "criteria_file": None if criteria_file is None else str(Path(criteria_file).resolve()),
                   "load_units": list(load_units) if load_units else None}
         t0 = time.perf_counter()
         nb_dir = staged / "notebooks"

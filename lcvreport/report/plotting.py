@@ -557,19 +557,78 @@ def plot_single_sine(ss, ax=None) -> Figure:
 
 
 def fig_frequency(f_hz: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: str, title: str,
-                  mark_hz: float | None = None, logy: bool = False) -> Figure:
+                  mark_hz: float | None = None, logy: bool = False, peak: tuple | None = None) -> Figure:
     """Curves against frequency [Hz] (RA(f), gains)."""
     fig, ax = new_figure(PAGE_WIDTH_IN, 3.2)
     for i, (label, y) in enumerate(curves):
         ax.plot(f_hz, y, color=PALETTE[i % len(PALETTE)], lw=1.1, label=label)
     if mark_hz is not None:
         ax.axvline(mark_hz, color="black", ls=":", lw=1)
+    if peak is not None:
+        ax.plot([peak[0]], [peak[1]], "o", color="black", ms=4)
+        ax.annotate(f"peak {peak[1]:.3f} at {peak[0]:.3f} Hz", peak, xytext=(10, 4), textcoords="offset points",
+                    fontsize=SMALL_PT)
     if logy:
         ax.set_yscale("log")
     ax.set_xlabel("steer frequency [Hz]")
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3, which="both")
     ax.legend(fontsize=SMALL_PT, ncol=2)
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
+def fig_lane_change(lc, title: str) -> Figure:
+    """The path-following lane change (:class:`lcvreport.analysis.field_measures.LaneChangeMeasures`):
+    the steer [deg]; the paths of the steered axle and of the rearmost axle [m] with the
+    final offset and HSTO marked; the steered axle's and the last unit's lateral
+    accelerations [m/s^2]."""
+    r = lc.response
+    fig, axes = new_figure(PAGE_WIDTH_IN, 5.6, nrows=3, sharex=True)
+    axes[0].plot(r.time, np.degrees(r["delta"]), color="black", lw=1.0)
+    axes[0].set_ylabel("steer [deg]")
+    ys, yr = r[f"Y_{lc.steered_axle}"], r[f"Y_{lc.rear_axle}"]
+    axes[1].plot(r.time, ys, color=PALETTE[0], lw=1.1, label=f"steered axle {lc.steered_axle}")
+    axes[1].plot(r.time, yr, color=PALETTE[1], lw=1.1, label=f"rearmost axle {lc.rear_axle}")
+    axes[1].axhline(lc.final_offset_m, color="gray", ls=":", lw=0.9)
+    k = int(np.argmax(np.sign(lc.final_offset_m or 1.0) * (yr - lc.final_offset_m)))
+    if lc.hsto_m > 0:
+        axes[1].annotate(f"HSTO {lc.hsto_m:.3f} m", (r.time[k], yr[k]), xytext=(12, -14), textcoords="offset points",
+                         fontsize=SMALL_PT, arrowprops={"arrowstyle": "->", "lw": 0.6})
+        axes[1].plot([r.time[k], r.time[k]], [lc.final_offset_m, yr[k]], color=PALETTE[1], lw=2.0)
+    axes[1].set_ylabel("lateral position [m]")
+    axes[1].legend(fontsize=SMALL_PT, loc="lower right")
+    n = r.vehicle.n_units
+    axes[2].plot(r.time, r["a_steer"], color=PALETTE[0], lw=1.0, label="steered axle a_s")
+    axes[2].plot(r.time, r[f"ay{n}"], color=PALETTE[1], lw=1.0, label=f"a{n} (last unit's CG)")
+    axes[2].set_ylabel("lateral acc. [m/s²]")
+    axes[2].set_xlabel("time [s]")
+    axes[2].legend(fontsize=SMALL_PT, loc="lower right")
+    for ax in axes:
+        ax.grid(True, lw=0.3)
+    axes[0].set_title(title, fontsize=9)
+    return fig
+
+
+def fig_pulse(ydc, names: list[str], title: str) -> Figure:
+    """Articulation angles [deg] after the pulse steer of the yaw damping measure, the
+    extrema the ratio method uses marked (:class:`lcvreport.analysis.field_measures.YawDamping`)."""
+    r = ydc.response
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
+    end = min(r.time[-1], 12.0)
+    sel = r.time <= end
+    for i, name in enumerate(names):
+        c = PALETTE[i % len(PALETTE)]
+        ax.plot(r.time[sel], np.degrees(r[name][sel]), color=c, lw=1.0,
+                label=f"{name} (ζ {ydc.per_joint[i]:.3f})" if ydc.per_joint[i] is not None else name)
+        t, v = ydc.extrema[i]
+        used = len(ydc.amplitudes[i]) + 1 if len(ydc.amplitudes[i]) else 0
+        keep = np.arange(t.size) < used
+        ax.plot(t[keep & (t <= end)], np.degrees(v[keep & (t <= end)]), "o", ms=3, color=c)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("articulation angle [deg]")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.18), frameon=False)
     ax.set_title(title, fontsize=9)
     return fig
 
