@@ -339,3 +339,30 @@ def test_outputs_read_after_new_inputs_without_a_step_use_the_new_inputs(preset_
     got = np.array([after[names.index(f"ay{i}")] for i in range(1, 7)])
     np.testing.assert_allclose(got, ay, rtol=1e-9, atol=1e-12 * np.abs(ay).max())
     assert after[names.index("max_real_eig")] == pytest.approx(eigenvalues(v, 15.0).real.max(), rel=1e-12)
+
+
+def test_a_misalignment_input_drives_the_fmu_to_the_packages_steady_state(preset_fmu):
+    """eps<axle> (SPEC 11 misalignment) held: the FMU settles where the package's
+    residual sources put the model, -S^-1 F (a steady circle), whatever the kind of FMU."""
+    from lcvreport.analysis.steady import steady_state
+    from lcvreport.model.loads import ResidualSources
+    v = load_preset("aucnat")
+    s = Slave(preset_fmu, preset="aucnat", tire_scale=0.8).init()
+    s.set(eps41=0.002, eps21=-0.001, u=20.0)
+    for _ in range(12):
+        s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=5.0)
+    got = s.get(list(v.state_names[:1]) + [f"r{i}" for i in range(1, 7)] + ["thetaA", "thetaB", "thetaC", "thetaD",
+                                                                             "thetaE"])
+    s.free()
+    F = ResidualSources(misalignment_rad={"41": 0.002, "21": -0.001}).vector(v, tire_scale=0.8)
+    x = steady_state(v, 20.0, F, 0.8)
+    np.testing.assert_allclose(got, x, rtol=1e-9, atol=1e-12 * np.abs(x).max())
+
+
+def test_a_misalignment_beyond_the_range_is_refused(preset_fmu):
+    s = Slave(preset_fmu, preset="aucnat").init()
+    s.set(eps61=0.2)
+    with pytest.raises(Exception):
+        s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
+    assert any("eps61 = 0.2 is outside [-0.05, 0.05]" in m for m in s.log.messages(3)), s.log.messages(3)
+    s.free()

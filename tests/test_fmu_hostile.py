@@ -121,7 +121,9 @@ def test_hostile_calls_in_a_plain_c_host(c_host, unzipped_fmus, identifier, scri
 
 def test_nan_in_a_serialized_state_is_refused_with_a_message_by_the_c_fmu(c_host, unzipped_fmus):
     d, _guid, vr = unzipped = unzipped_fmus["LCVNative"]
-    offset = 4 + 4 + 64 + 64 + 16 + 8 * 18        # z[0] of the snapshot (see fmi2_api.c, model.h)
+    from lcvreport.fmu.interface import preset_interface
+    n_inputs = len(preset_interface().inputs)
+    offset = 4 + 4 + 64 + 64 + 16 + 8 * n_inputs  # z[0] of the snapshot (see fmi2_api.c, model.h)
     p = run_host(c_host, unzipped, "LCVNative", f"i\nd 0 0.01\nG\nN {offset}\nF\n")
     assert host_statuses(p.stdout) == [0, 0, 0, 3, 0]
     assert any(line.startswith("log 3") and "not finite" in line for line in p.stdout.splitlines()), p.stdout
@@ -203,7 +205,8 @@ def test_a_crafted_state_stepping_without_a_vehicle_is_refused_by_the_c_fmu(c_ho
     """Phase 'step complete' with no vehicle built (taken before initialization, phase
     field rewritten) used to pass the checks and segfault the next doStep."""
     unzipped = unzipped_fmus["LCVNative"]
-    n_inputs, max_m = 18, 14                          # the preset FMU: 18 inputs, 12 states + psi1, Y1
+    from lcvreport.fmu.interface import preset_interface
+    n_inputs, max_m = len(preset_interface().inputs), 14     # the preset FMU: 12 states + psi1, Y1
     phase_offset = 4 + 4 + 64 + 64 + 16 + 8 * n_inputs + 8 * max_m + 16 + 4   # see fmi2_api.c, model.h
     p = run_host(c_host, unzipped, "LCVNative", f"G\nK {phase_offset} 4\nP\nd 0 0.01\nF\n")
     assert p.returncode == 0 and p.stdout.rstrip().endswith("done"), (p.stdout[-2000:], p.stderr[-2000:])

@@ -53,7 +53,11 @@ static void build_input_matrix(ModelInstance *c)
     const LcvVehicle *v = vehicle_of(c);
     int n = v->n;
     memcpy(c->Bw, v->Bw, sizeof(double) * (size_t)n * LCV_N_INPUTS);
-    for (int i = 0; i < n; ++i) c->Bw[i * LCV_N_INPUTS + LCV_IN_DELTA] = c->s.tire_scale * v->Bdelta[i];
+    for (int i = 0; i < n; ++i) {
+        c->Bw[i * LCV_N_INPUTS + LCV_IN_DELTA] = c->s.tire_scale * v->Bdelta[i];
+        for (int k = 0; k < LCV_N_INPUTS; ++k)          /* a misalignment acts like a steer of its axle */
+            if (LCV_INPUT_KIND[k] == LCV_IN_EPS) c->Bw[i * LCV_N_INPUTS + k] *= c->s.tire_scale;
+    }
 }
 
 int model_exit_initialization(ModelInstance *c)
@@ -234,6 +238,7 @@ static int check_inputs_(ModelInstance *c, int speed)
             continue;
         case LCV_IN_STEER: lim = LCV_STEER_MAX; break;
         case LCV_IN_FORCE: lim = LCV_FORCE_MAX; break;
+        case LCV_IN_EPS: lim = LCV_EPS_MAX; break;
         default: lim = LCV_MOMENT_MAX; break;
         }
         if (fabs(x) > lim) {

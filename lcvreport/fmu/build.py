@@ -154,9 +154,10 @@ def config_header(itf: Interface, model_identifier: str, fmu_guid: str) -> str:
         f"#define LCV_STEP_LOW {_c_double(r['step_size'].low)}", f"#define LCV_STEP_HIGH {_c_double(r['step_size'].high)}",
         f"#define LCV_STEER_MAX {_c_double(r['steer_angle'].high)}",
         f"#define LCV_FORCE_MAX {_c_double(r['residual_force'].high)}",
-        f"#define LCV_MOMENT_MAX {_c_double(r['residual_moment'].high)}", "",
+        f"#define LCV_MOMENT_MAX {_c_double(r['residual_moment'].high)}",
+        f"#define LCV_EPS_MAX {_c_double(r['misalignment'].high)}", "",
         "/* kinds of inputs and outputs (config_data.h says which is which) */",
-        "enum { LCV_IN_SPEED, LCV_IN_STEER, LCV_IN_FORCE, LCV_IN_MOMENT };",
+        "enum { LCV_IN_SPEED, LCV_IN_STEER, LCV_IN_FORCE, LCV_IN_MOMENT, LCV_IN_EPS };",
         "enum { LCV_OUT_LINEAR, LCV_OUT_LATERAL, LCV_OUT_ACCEL, LCV_OUT_MAX_REAL_EIG };", "",
         "#endif", ""]
     return "\n".join(lines)
@@ -164,7 +165,8 @@ def config_header(itf: Interface, model_identifier: str, fmu_guid: str) -> str:
 
 def config_data_header(itf: Interface) -> str:
     """``config_data.h``: names, start values and kinds of the variables (included by model.c only)."""
-    in_kind = {"speed": "LCV_IN_SPEED", "steer": "LCV_IN_STEER", "P": "LCV_IN_FORCE", "T": "LCV_IN_MOMENT"}
+    in_kind = {"speed": "LCV_IN_SPEED", "steer": "LCV_IN_STEER", "P": "LCV_IN_FORCE", "T": "LCV_IN_MOMENT",
+               "eps": "LCV_IN_EPS"}
     out_kind = {"y": "LCV_OUT_LATERAL", "ay": "LCV_OUT_ACCEL", "max_real_eig": "LCV_OUT_MAX_REAL_EIG"}
     names = ", ".join(_c_string(v.name) for v in itf.variables)
     return "\n".join([

@@ -56,6 +56,10 @@ class CosimError(ValueError):
 STATE_MAGIC = "lcv-fmu-state/1"
 
 
+#: the range of each kind of residual input
+_INPUT_RANGE = {"P": "residual_force", "T": "residual_moment", "eps": "misalignment"}
+
+
 class LCVEngine:
     """Exact zero-order-hold stepping of one vehicle through an FMU interface (SI).
 
@@ -123,12 +127,13 @@ class LCVEngine:
             if kind == "steer":
                 self._Bw[:, k] = co.B_delta(self.tire_scale)
                 self._ranges.append(RANGES["steer_angle"])
-            elif kind in ("P", "T") and var.source[1] in axles:
+            elif kind in ("P", "T", "eps") and var.source[1] in axles:
                 col = axles.index(var.source[1])
-                self._Bw[:, k] = (co.B_P if kind == "P" else co.B_T)[:, col]
-                self._ranges.append(RANGES["residual_force" if kind == "P" else "residual_moment"])
-            elif kind in ("P", "T"):  # an axle the preset lacks: ignored
-                self._ranges.append(RANGES["residual_force" if kind == "P" else "residual_moment"])
+                self._Bw[:, k] = {"P": co.B_P, "T": co.B_T}[kind][:, col] if kind != "eps" else \
+                    self.tire_scale * co.B_eps[:, col]       # a misalignment acts like a steer of that axle
+                self._ranges.append(RANGES[_INPUT_RANGE[kind]])
+            elif kind in ("P", "T", "eps"):  # an axle the preset lacks: ignored
+                self._ranges.append(RANGES[_INPUT_RANGE[kind]])
             else:
                 self._ranges.append(None)
         self._range_lo = np.array([-np.inf if r is None else r.low for r in self._ranges])
@@ -168,7 +173,7 @@ class LCVEngine:
 
     def maps(self) -> dict:
         """The engine's input and output maps (what the C FMU's generated data holds):
-        ``Bw`` (2N x inputs, steer column at tire scale 1), ``C`` (outputs x 2N+2),
+        ``Bw`` (2N x inputs, steer and misalignment columns at tire scale 1), ``C`` (outputs x 2N+2),
         ``H`` (N-1 x 2N+2), ``W`` (outputs x N-1), ``ay_unit`` (outputs; -1: not an ay),
         ``eig_out`` (index of max_real_eig or -1)."""
         Bw = self._Bw.copy()
@@ -176,6 +181,8 @@ class LCVEngine:
             for k, var in enumerate(self.interface.inputs):
                 if var.source[0] == "steer":
                     Bw[:, k] = self.co.B_delta(1.0)
+                elif var.source[0] == "eps":
+                    Bw[:, k] /= self.tire_scale
         return {"Bw": Bw, "C": self._C.copy(), "H": self._H.copy(), "W": self._W.copy(),
                 "ay_unit": self._ay_unit.copy(), "eig_out": self._eig_out}
 

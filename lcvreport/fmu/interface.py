@@ -220,6 +220,11 @@ def preset_interface() -> Interface:
         t.add(f"T{a}", "input", "continuous", "moment", 0.0, f"Residual aligning moment of axle {a} (axle {a[1]} of "
               f"unit {a[0]}), about +z (down), positive nose-right; ignored if the preset lacks the axle",
               ("T", a), range_key="residual_moment")
+    for a in PRESET_AXLES:
+        t.add(f"eps{a}", "input", "continuous", "angle", 0.0, f"Misalignment (thrust angle) of axle {a} (axle {a[1]} "
+              f"of unit {a[0]}), nose-right positive: the axle's slip angle gains it; in "
+              f"{RANGES['misalignment'].text()}; ignored if the preset lacks the axle", ("eps", a),
+              range_key="misalignment")
     t.add("v1", "output", "continuous", "speed", None, "Tractor lateral velocity at the CG, +y", ("state", "v1"))
     for i in range(1, PRESET_UNITS + 1):
         t.add(f"r{i}", "output", "continuous", "rate", None, f"Yaw rate of unit {i} (1 tractor, 2 trailer 1, 3 dolly 1, "
@@ -260,6 +265,11 @@ def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START) -> Interfa
             t.add(f"T_{a.name}", "input", "continuous", "moment", 0.0, f"Residual aligning moment of axle {a.name} of "
                   f"{u.name} (unit {i + 1}), about +z (down), positive nose-right", ("T", a.name),
                   range_key="residual_moment")
+    for i, u in enumerate(vehicle.units):
+        for a in u.axles:
+            t.add(f"eps_{a.name}", "input", "continuous", "angle", 0.0, f"Misalignment (thrust angle) of axle {a.name} "
+                  f"of {u.name} (unit {i + 1}), nose-right positive: the axle's slip angle gains it; in "
+                  f"{RANGES['misalignment'].text()}", ("eps", a.name), range_key="misalignment")
     n = vehicle.n_units
     t.add("v1", "output", "continuous", "speed", None, f"Lateral velocity of the CG of {vehicle.units[0].name}, +y",
           ("state", "v1"))
