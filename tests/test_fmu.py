@@ -366,3 +366,31 @@ def test_a_misalignment_beyond_the_range_is_refused(preset_fmu):
         s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
     assert any("eps61 = 0.2 is outside [-0.05, 0.05]" in m for m in s.log.messages(3)), s.log.messages(3)
     s.free()
+
+
+def test_the_crossfall_parameter_drives_the_fmu_to_the_packages_steady_state(preset_fmu):
+    from lcvreport.analysis.steady import steady_state
+    from lcvreport.model.loads import ResidualSources
+    v = load_preset("aucnat")
+    s = Slave(preset_fmu, preset="aucnat", crossfall=-3.0).init()
+    s.set(u=25.0, eps61=0.001)
+    for _ in range(12):
+        s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=5.0)
+    names = ["v1"] + [f"r{i}" for i in range(1, 7)] + ["thetaA", "thetaB", "thetaC", "thetaD", "thetaE"]
+    got = s.get(names)
+    ay = s.get([f"ay{i}" for i in range(1, 7)])
+    s.free()
+    F = ResidualSources(misalignment_rad={"61": 0.001}, crossfall_percent=-3.0).vector(v)
+    x = steady_state(v, 25.0, F)
+    np.testing.assert_allclose(got, x, rtol=1e-9, atol=1e-12 * np.abs(x).max())
+    co = system_coefficients(v)
+    Ca, Da = co.acceleration_maps(25.0)
+    np.testing.assert_allclose(ay, Ca @ x + Da @ F, rtol=1e-8, atol=1e-12)
+
+
+def test_a_crossfall_beyond_the_range_is_refused_at_initialization(preset_fmu):
+    s = Slave(preset_fmu, preset="aucnat", crossfall=30.0)
+    with pytest.raises(Exception):
+        s.fmu.exitInitializationMode()
+    assert any("crossfall must be in [-20, 20]" in m for m in s.log.messages(3)), s.log.messages(3)
+    s.fmu.freeInstance()

@@ -332,7 +332,8 @@ fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate state)
     const Snapshot *snap = (const Snapshot *)state;
     if (!snap) { logmsg(c, fmi2Error, "fmi2SetFMUstate: null state"); return fmi2Error; }
     if (!snapshot_ok(c, snap)) return fmi2Error;
-    int same = c->s.vehicle == snap->s.vehicle && c->s.tire_scale == snap->s.tire_scale;
+    int same = c->s.vehicle == snap->s.vehicle && c->s.tire_scale == snap->s.tire_scale &&
+               c->s.crossfall == snap->s.crossfall;
     c->s = snap->s;
     model_state_restored(c, same);
     return fmi2OK;

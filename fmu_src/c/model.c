@@ -24,6 +24,7 @@ void model_reset(ModelInstance *c)
     snprintf(c->s.preset, sizeof c->s.preset, "%s", LCV_DEFAULT_PRESET);
     c->s.tire_scale = LCV_DEFAULT_TIRE_SCALE;
     c->s.u_min = LCV_DEFAULT_U_MIN;
+    c->s.crossfall = LCV_DEFAULT_CROSSFALL;
     for (int k = 0; k < LCV_N_INPUTS; ++k) c->s.w[k] = LCV_INPUT_START[k];
     c->s.last_speed = LCV_INPUT_START[0] > LCV_DEFAULT_U_MIN ? LCV_INPUT_START[0] : LCV_DEFAULT_U_MIN;
     c->s.phase = PhaseInstantiated;
@@ -57,6 +58,7 @@ static void build_input_matrix(ModelInstance *c)
         c->Bw[i * LCV_N_INPUTS + LCV_IN_DELTA] = c->s.tire_scale * v->Bdelta[i];
         for (int k = 0; k < LCV_N_INPUTS; ++k)          /* a misalignment acts like a steer of its axle */
             if (LCV_INPUT_KIND[k] == LCV_IN_EPS) c->Bw[i * LCV_N_INPUTS + k] *= c->s.tire_scale;
+        c->Fc[i] = sin(atan(c->s.crossfall / 100.0)) * v->Bc[i];
     }
 }
 
@@ -75,6 +77,11 @@ int model_exit_initialization(ModelInstance *c)
     if (!in_range(c->s.u_min, LCV_U_MIN_LOW, LCV_U_MIN_HIGH)) {
         snprintf(c->msg, sizeof c->msg, "u_min must be in [%.4g, %.4g] m/s, got %.6g", LCV_U_MIN_LOW,
                  LCV_U_MIN_HIGH, c->s.u_min);
+        return -1;
+    }
+    if (!in_range(c->s.crossfall, LCV_CROSSFALL_LOW, LCV_CROSSFALL_HIGH)) {
+        snprintf(c->msg, sizeof c->msg, "crossfall must be in [%.4g, %.4g] %%, got %.6g", LCV_CROSSFALL_LOW,
+                 LCV_CROSSFALL_HIGH, c->s.crossfall);
         return -1;
     }
     c->s.vehicle = k;
@@ -136,6 +143,11 @@ static SpeedEntry *speed_entry(ModelInstance *c, double u)
             Da[(size_t)i * n + j] = s;
         }
     lcv_matmul(Da, n, c->Bw, LCV_N_INPUTS, slot->DaB, LCV_N_INPUTS, N, n, LCV_N_INPUTS);
+    for (int i = 0; i < N; ++i) {
+        double s = 0.0;
+        for (int l = 0; l < n; ++l) s += Da[(size_t)i * n + l] * c->Fc[l];
+        slot->daF[i] = s;
+    }
     slot->u = u;
     slot->eig_state = 0;
     slot->valid = 1;
@@ -167,13 +179,13 @@ static int max_real_eig(ModelInstance *c, double u, double *value)
 
 /* [Ad, Gd Bw] for speed u [m/s] and step h [s], from exp([[A_aug h, G_aug h], [0, 0]]) with
    A_aug = [[M^-1 S, 0], [e_r1, 0, 0], [e_v1, u, 0]], G_aug = [M^-1; 0] (cached). */
-static const double *step_matrix(ModelInstance *c, double u, double h)
+static const StepEntry *step_matrix(ModelInstance *c, double u, double h)
 {
     const LcvVehicle *v = vehicle_of(c);
     StepEntry *slot = NULL, *oldest = &c->steps[0];
     for (int i = 0; i < LCV_N_STEP_CACHE; ++i) {
         StepEntry *e = &c->steps[i];
-        if (e->valid && e->u == u && e->h == h) { e->stamp = ++c->clock; return e->K; }
+        if (e->valid && e->u == u && e->h == h) { e->stamp = ++c->clock; return e; }
         if (!e->valid) { if (!slot) slot = e; }
         else if (e->stamp < oldest->stamp) oldest = e;
     }
@@ -206,12 +218,15 @@ static const double *step_matrix(ModelInstance *c, double u, double h)
             for (int l = 0; l < n; ++l) s += E[(size_t)i * nb + m + l] * c->Bw[(size_t)l * LCV_N_INPUTS + j];
             slot->K[(size_t)i * ld + m + j] = s;
         }
+        double g = 0.0;
+        for (int l = 0; l < n; ++l) g += E[(size_t)i * nb + m + l] * c->Fc[l];
+        slot->gc[i] = g;
     }
     slot->valid = 1;
     slot->u = u;
     slot->h = h;
     slot->stamp = ++c->clock;
-    return slot->K;
+    return slot;
 }
 
 /* ------------------------------------------------------------------ inputs and steps */
@@ -269,7 +284,8 @@ int model_do_step(ModelInstance *c, double h)
                  "rises again (the linear model needs a forward speed)", u_in, c->s.u_min);
         warn = 1;
     }
-    const double *K = step_matrix(c, u, h);
+    const StepEntry *step = step_matrix(c, u, h);
+    const double *K = step ? step->K : NULL;
     if (!K) {
         snprintf(c->msg, sizeof c->msg, "the discretization failed at u = %.6g m/s, h = %.6g s (not finite); the "
                  "step is refused and the state is unchanged", u, h);
@@ -281,6 +297,7 @@ int model_do_step(ModelInstance *c, double h)
         double s = 0.0;
         for (int j = 0; j < m; ++j) s += row[j] * c->s.z[j];
         for (int j = 0; j < LCV_N_INPUTS; ++j) s += row[m + j] * c->s.w[j];
+        s += step->gc[i];
         if (!isfinite(s)) {
             double e = 0.0;
             int ok = max_real_eig(c, u, &e) == 0;
@@ -346,6 +363,7 @@ static void compute_outputs(ModelInstance *c, double *out, int *valid)
             }
             for (int j = 0; j < n; ++j) s += se->Ca[(size_t)i * n + j] * c->s.z[j];
             for (int j = 0; j < LCV_N_INPUTS; ++j) s += se->DaB[(size_t)i * LCV_N_INPUTS + j] * c->s.w[j];
+            s += se->daF[i];
             break;
         }
         default:
@@ -374,6 +392,7 @@ int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, 
         switch (r) {
         case vr_tire_scale: value[i] = c->s.tire_scale; continue;
         case vr_u_min: value[i] = c->s.u_min; continue;
+        case vr_crossfall: value[i] = c->s.crossfall; continue;
         default: break;
         }
         if (r >= LCV_FIRST_INPUT && r < LCV_FIRST_INPUT + LCV_N_INPUTS) {
@@ -401,12 +420,15 @@ int model_set_real(ModelInstance *c, fmi2ValueReference vr, double value)
     switch (vr) {
     case vr_tire_scale:
     case vr_u_min:
+    case vr_crossfall:
         if (!(c->s.phase & (PhaseInstantiated | PhaseInitializationMode))) {
             snprintf(c->msg, sizeof c->msg, "%s is a fixed parameter: it cannot change after initialization",
                      LCV_VARIABLE_NAMES[vr]);
             return -1;
         }
-        if (vr == vr_tire_scale) c->s.tire_scale = value; else c->s.u_min = value;
+        if (vr == vr_tire_scale) c->s.tire_scale = value;
+        else if (vr == vr_u_min) c->s.u_min = value;
+        else c->s.crossfall = value;
         return 0;
     default:
         break;
@@ -466,7 +488,8 @@ int model_check_state(ModelInstance *c, const ModelState *s)
         snprintf(c->msg, sizeof c->msg, "the FMU state is refused: it was not written by this FMU");
         return -1;
     }
-    int finite = isfinite(s->tire_scale) && isfinite(s->u_min) && isfinite(s->time) && isfinite(s->last_speed);
+    int finite = isfinite(s->tire_scale) && isfinite(s->u_min) && isfinite(s->time) && isfinite(s->last_speed) &&
+                 isfinite(s->crossfall);
     for (int i = 0; i < LCV_MAX_M; ++i) finite = finite && isfinite(s->z[i]);
     for (int k = 0; k < LCV_N_INPUTS; ++k) finite = finite && !isnan(s->w[k]);
     if (!finite) {
@@ -474,7 +497,8 @@ int model_check_state(ModelInstance *c, const ModelState *s)
         return -1;
     }
     if (s->vehicle >= 0 && (!in_range(s->tire_scale, LCV_TIRE_SCALE_LOW, LCV_TIRE_SCALE_HIGH) ||
-                            !in_range(s->u_min, LCV_U_MIN_LOW, LCV_U_MIN_HIGH))) {
+                            !in_range(s->u_min, LCV_U_MIN_LOW, LCV_U_MIN_HIGH) ||
+                            !in_range(s->crossfall, LCV_CROSSFALL_LOW, LCV_CROSSFALL_HIGH))) {
         snprintf(c->msg, sizeof c->msg, "the FMU state is refused: its parameters are out of range");
         return -1;
     }

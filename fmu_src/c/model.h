@@ -25,6 +25,7 @@ typedef struct {
     int phase;                          /* Phase */
     int vehicle;                        /* index into LCV_VEHICLES, -1 before initialization */
     char error[1024];                   /* why the instance is in PhaseError */
+    double crossfall;                   /* fixed parameter [%] */
 } ModelState;
 
 typedef struct {
@@ -32,6 +33,7 @@ typedef struct {
     double u, h;
     unsigned long stamp;
     double K[LCV_MAX_M * (LCV_MAX_M + LCV_N_INPUTS)];   /* [Ad, Gd Bw] row-major, ld = m + NW */
+    double gc[LCV_MAX_M];                               /* Gd Fc: the crossfall's share of a step */
 } StepEntry;
 
 typedef struct {
@@ -41,6 +43,7 @@ typedef struct {
     double A[LCV_MAX_STATES * LCV_MAX_STATES];          /* M^-1 S */
     double Ca[LCV_MAX_UNITS * LCV_MAX_STATES];          /* a = Ca x + DaB w */
     double DaB[LCV_MAX_UNITS * LCV_N_INPUTS];
+    double daF[LCV_MAX_UNITS];                          /* Da Fc: the crossfall's lateral accelerations */
     int eig_state;                                      /* 0 not computed, 1 ok, -1 failed */
     double eig;                                         /* max real part [1/s] */
 } SpeedEntry;
@@ -54,6 +57,7 @@ typedef struct ModelInstance {
     int logging_on;
     ModelState s;
     double Bw[LCV_MAX_STATES * LCV_N_INPUTS];            /* generalized force per SI input, tire-scaled */
+    double Fc[LCV_MAX_STATES];                           /* the crossfall's constant generalized force */
     StepEntry steps[LCV_N_STEP_CACHE];
     SpeedEntry speeds[LCV_N_SPEED_CACHE];
     unsigned long clock;

@@ -22,6 +22,7 @@ typedef struct {
     const double *Vq;             /* N x n: lateral velocity of the unit CGs, the u-free part */
     const double *Vth;            /* N x n: the part proportional to u (u K on the theta columns) */
     const double *R;              /* N x n: yaw rates of the units */
+    const double *Bc;             /* n: generalized force per unit of sin(atan(crossfall)) (m_i g at the CGs) */
 } LcvVehicle;
 
 #endif

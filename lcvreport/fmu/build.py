@@ -18,7 +18,7 @@ Examples
 --------
 >>> from lcvreport import load_preset
 >>> text = config_header(vehicle_interface(load_preset("tractor_semitrailer")), "x", "{guid}")
->>> "vr_P_21 = 7" in text
+>>> "vr_P_21 = 8" in text
 True
 """
 from __future__ import annotations
@@ -145,7 +145,8 @@ def config_header(itf: Interface, model_identifier: str, fmu_guid: str) -> str:
         f"#define LCV_DEFAULT_PRESET {_c_string(itf.vehicles[0].name)}",
         f"#define LCV_PRESET_LIST {_c_string(', '.join(v.name for v in itf.vehicles))}",
         f"#define LCV_DEFAULT_TIRE_SCALE {_c_double(itf.by_name['tire_scale'].start)}",
-        f"#define LCV_DEFAULT_U_MIN {_c_double(itf.by_name['u_min'].start)}", "",
+        f"#define LCV_DEFAULT_U_MIN {_c_double(itf.by_name['u_min'].start)}",
+        f"#define LCV_DEFAULT_CROSSFALL {_c_double(itf.by_name['crossfall'].start)}", "",
         "/* valid ranges (lcvreport.ranges.RANGES) */",
         f"#define LCV_SPEED_MAX {_c_double(r['speed'].high)}",
         f"#define LCV_U_MIN_LOW {_c_double(r['u_min'].low)}", f"#define LCV_U_MIN_HIGH {_c_double(r['u_min'].high)}",
@@ -155,7 +156,9 @@ def config_header(itf: Interface, model_identifier: str, fmu_guid: str) -> str:
         f"#define LCV_STEER_MAX {_c_double(r['steer_angle'].high)}",
         f"#define LCV_FORCE_MAX {_c_double(r['residual_force'].high)}",
         f"#define LCV_MOMENT_MAX {_c_double(r['residual_moment'].high)}",
-        f"#define LCV_EPS_MAX {_c_double(r['misalignment'].high)}", "",
+        f"#define LCV_EPS_MAX {_c_double(r['misalignment'].high)}",
+        f"#define LCV_CROSSFALL_LOW {_c_double(r['crossfall'].low)}",
+        f"#define LCV_CROSSFALL_HIGH {_c_double(r['crossfall'].high)}", "",
         "/* kinds of inputs and outputs (config_data.h says which is which) */",
         "enum { LCV_IN_SPEED, LCV_IN_STEER, LCV_IN_FORCE, LCV_IN_MOMENT, LCV_IN_EPS };",
         "enum { LCV_OUT_LINEAR, LCV_OUT_LATERAL, LCV_OUT_ACCEL, LCV_OUT_MAX_REAL_EIG };", "",
@@ -204,13 +207,13 @@ def vehicle_data_header(itf: Interface) -> str:
         p = f"v{k}"
         arrays = {"M0": co.M0, "M1": co.M1, "S0": co.S0, "Sinv": co.Sinv, "Su": co.Su, "Skin": co.Skin,
                   "Bdelta": co.Bdelta, "Bw": maps["Bw"], "C": maps["C"], "H": maps["H"], "W": maps["W"],
-                  "Vq": Vq, "Vth": Vth, "R": co.yaw_rate_map()}
+                  "Vq": Vq, "Vth": Vth, "R": co.yaw_rate_map(), "Bc": co.B_crossfall}
         out.append(f"/* {v.name}: {N} units, {n} states */")
         for name, arr in arrays.items():
             out.append(_c_array("double", f"{p}_{name}", arr))
         out.append(_c_array("int", f"{p}_ay_unit", maps["ay_unit"]))
         entries.append(f"    {{{_c_string(v.name)}, {N}, {n}, " + ", ".join(f"{p}_{a}" for a in (
-            "M0", "M1", "S0", "Sinv", "Su", "Skin", "Bdelta", "Bw", "C", "H", "W", "ay_unit", "Vq", "Vth", "R"))
+            "M0", "M1", "S0", "Sinv", "Su", "Skin", "Bdelta", "Bw", "C", "H", "W", "ay_unit", "Vq", "Vth", "R", "Bc"))
             + "}")
     out.append("static const LcvVehicle LCV_VEHICLES[LCV_N_VEHICLES] = {\n" + ",\n".join(entries) + "\n};")
     out += ["", "#endif", ""]

@@ -82,13 +82,13 @@ class LCVEngine:
     """
 
     def __init__(self, interface: Interface, preset: str | None = None, tire_scale: float = 1.0,
-                 u_min: float = 2.2352, cache_size: int = 128):
+                 u_min: float = 2.2352, cache_size: int = 128, crossfall: float = 0.0):
         self.interface = interface
         try:
             vehicle = interface.vehicle(preset)
         except KeyError as exc:
             raise CosimError("preset", str(exc.args[0])) from None
-        for name, value in (("tire_scale", tire_scale), ("u_min", u_min)):
+        for name, value in (("tire_scale", tire_scale), ("u_min", u_min), ("crossfall", crossfall)):
             try:
                 RANGES[name].check(value, name)
             except RangeError as exc:
@@ -97,7 +97,10 @@ class LCVEngine:
         self.vehicle = vehicle
         self.tire_scale = float(tire_scale)
         self.u_min = float(u_min)
+        self.crossfall = float(crossfall)
         self.co = system_coefficients(vehicle)
+        # the crossfall's constant generalized force: one more input column, always 1
+        self._Fc = math.sin(math.atan(self.crossfall / 100.0)) * self.co.B_crossfall
         self.n = vehicle.n_states
         self.m = self.n + 2
         self.input_names = tuple(v.name for v in interface.inputs)
@@ -107,7 +110,8 @@ class LCVEngine:
         self._steps = LRUCache(cache_size)
         self._speeds = LRUCache(1024)
         self._steps_out = LRUCache(cache_size)
-        self._zw = np.zeros(self.m + len(self.input_names))
+        self._zw = np.zeros(self.m + len(self.input_names) + 1)
+        self._zw[-1] = 1.0
         self.stepped_outputs = None
         self._last_h = None
         self._last_key = None
@@ -241,7 +245,7 @@ class LCVEngine:
             big[:self.m, :self.m] = A * h
             big[:self.m, self.m:] = G * h
             E = expm(big)
-            K = np.hstack([E[:self.m, :self.m], E[:self.m, self.m:] @ self._Bw])
+            K = np.hstack([E[:self.m, :self.m], E[:self.m, self.m:] @ self._Bw, E[:self.m, self.m:] @ self._Fc[:, None]])
             K.setflags(write=False)
             return K
         return self._steps.get((u, h), compute)
@@ -252,7 +256,7 @@ class LCVEngine:
         articulation angles of the rear-end offsets (cached per speed and step)."""
         def compute():
             K = self._step_matrix(u, h)
-            nw = len(self.input_names)
+            nw = len(self.input_names) + 1                       # the inputs and the constant 1
             P = np.vstack([K, np.hstack([np.zeros((nw, self.m)), np.eye(nw)])])
             rows = [K, self.output_matrix(u) @ P]
             if self._has_y:
@@ -266,7 +270,7 @@ class LCVEngine:
         """Output maps that depend on the speed: ay (Ca, Da Bw); max_real_eig (lazy)."""
         def compute():
             Ca, Da = self.co.acceleration_maps(u, self.tire_scale)
-            return {"Ca": Ca, "DaB": Da @ self._Bw, "eig": None}
+            return {"Ca": Ca, "DaB": Da @ self._Bw, "daF": Da @ self._Fc, "eig": None}
         return self._speeds.get(u, compute)
 
     def max_real_eig(self, u: float) -> float:
@@ -365,7 +369,7 @@ class LCVEngine:
         """``[z, w]`` in a buffer of the engine (valid until the next call)."""
         zw = self._zw
         zw[:self.m] = self.z
-        zw[self.m:] = w
+        zw[self.m:-1] = w
         return zw
 
     def rear_offsets(self) -> np.ndarray:
@@ -378,11 +382,12 @@ class LCVEngine:
         maps = self._speed_maps(u)
         O = maps.get("O")
         if O is None:
-            O = np.hstack([self._C, np.zeros((self._C.shape[0], len(self.input_names)))])
+            O = np.hstack([self._C, np.zeros((self._C.shape[0], len(self.input_names) + 1))])
             sel = np.flatnonzero(self._ay_unit >= 0)
             if sel.size:
                 O[sel, :self.n] = maps["Ca"][self._ay_unit[sel]]
-                O[sel, self.m:] = maps["DaB"][self._ay_unit[sel]]
+                O[sel, self.m:-1] = maps["DaB"][self._ay_unit[sel]]
+                O[sel, -1] = maps["daF"][self._ay_unit[sel]]
             O.setflags(write=False)
             maps["O"] = O
         return O
@@ -399,11 +404,8 @@ class LCVEngine:
         if problem is False:
             problem = self.input_problem(w, speed=False)
         u = self.output_speed(w)
-        zw = self._zw
-        zw[:self.m] = self.z
         if problem is None:
-            zw[self.m:] = w
-            out = self.output_matrix(u) @ zw
+            out = self.output_matrix(u) @ self.stacked(w)
         else:
             out = self._C @ self.z
             sel = self._ay_unit >= 0

@@ -12,19 +12,22 @@ one enum.
 Two interfaces (SPEC sections 5 and 9):
 
 * :func:`preset_interface`: ``LCV`` / ``LCVNative`` -- a ``preset`` parameter picks one
-  of the six thesis vehicles; inputs ``P11 .. P61``, ``T11 .. T61`` of the thesis axles;
-  outputs for six units (0 where the preset has fewer), joints lettered ``thetaA ..
-  thetaE``, and ``ay1 .. ay6`` appended after the SPEC section 5 outputs (their value
-  references are unchanged).
-* :func:`vehicle_interface`: the vehicle built in; inputs ``P_<axle>``, ``T_<axle>``;
-  outputs ``v1, r1..rN, theta1..theta(N-1), ay1..ayN, y2..yN, psi1, Y1, Y_rear,
-  max_real_eig``.
+  of the six thesis vehicles; parameters ``tire_scale``, ``u_min``, ``crossfall``; inputs
+  ``P11 .. P61``, ``T11 .. T61``, ``eps11 .. eps61`` of the thesis axles; outputs for six
+  units (0 where the preset has fewer), joints lettered ``thetaA .. thetaE``, and ``ay1
+  .. ay6`` after the SPEC section 5 outputs.
+* :func:`vehicle_interface`: the vehicle built in; inputs ``P_<axle>``, ``T_<axle>``,
+  ``eps_<axle>``; outputs ``v1, r1..rN, theta1..theta(N-1), ay1..ayN, y2..yN, psi1, Y1,
+  Y_rear, max_real_eig``.
+
+Value references are the table's order: parameters, inputs, outputs, each a block
+(address variables by name, as modelDescription.xml gives them).
 
 Examples
 --------
 >>> itf = preset_interface()
 >>> itf.by_name["y6"].value_reference, itf.by_name["ay1"].value_reference
-(37, 42)
+(46, 51)
 """
 from __future__ import annotations
 
@@ -44,7 +47,7 @@ PRESET_AXLES = ("11", "12", "13", "21", "31", "41", "51", "61")
 PRESET_UNITS = 6
 #: FMI unit name of each quantity kind (SI)
 UNITS = {"speed": "m/s", "angle": "rad", "rate": "rad/s", "force": "N", "moment": "N.m", "length": "m",
-         "accel": "m/s2", "per_s": "1/s", "factor": "1", "none": ""}
+         "accel": "m/s2", "per_s": "1/s", "factor": "1", "percent": "%", "none": ""}
 #: display unit of each quantity kind: the preset FMU keeps the thesis' (SPEC section 5),
 #: vehicle FMUs show km/h, degrees and SI
 DISPLAY_UNITS = {
@@ -182,6 +185,9 @@ def _parameters(t: _Table) -> None:
     t.add("u_min", "parameter", "fixed", "speed", U_MIN_DEFAULT,
           "Lowest forward speed the linear model is run at; a lower input u is clamped to it "
           f"(one warning), in {RANGES['u_min'].text()}", ("parameter", "u_min"), range_key="u_min")
+    t.add("crossfall", "parameter", "fixed", "percent", 0.0,
+          "Road crossfall, positive when the road falls toward +y: m_i g sin(atan(crossfall/100)) along +y at every "
+          f"unit's CG, in {RANGES['crossfall'].text()}", ("parameter", "crossfall"), range_key="crossfall")
 
 
 def _speed_and_steer(t: _Table, steer_text: str, u_start: float = U_START) -> None:

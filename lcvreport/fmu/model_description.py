@@ -33,6 +33,7 @@ UNIT_DEFINITIONS = {
     "m/s2": ({"m": 1, "s": -2}, [("g", 1 / 9.80665)]),
     "1/s": ({"s": -1}, []),
     "1": ({}, []),
+    "%": ({"factor": 0.01}, []),
 }
 #: log categories of both FMUs
 LOG_CATEGORIES = {

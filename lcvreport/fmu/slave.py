@@ -112,7 +112,7 @@ class LCV(Fmi2Slave):
                 self._error("fmi2ExitInitializationMode called twice; call fmi2Reset to start again")
                 return
             self.engine = LCVEngine(self.itf, self.params.get("preset"), self.params["tire_scale"],
-                                    self.params["u_min"])
+                                    self.params["u_min"], crossfall=self.params["crossfall"])
             self.init_error = None
             self.initialized = True
             self._values = None
@@ -315,9 +315,10 @@ class LCV(Fmi2Slave):
             engine = None
             if state["engine"] is not None:
                 engine = self.engine
-                if engine is None or (engine.preset, engine.tire_scale, engine.u_min) != \
-                        (params.get("preset"), params["tire_scale"], params["u_min"]):
-                    engine = LCVEngine(self.itf, params.get("preset"), params["tire_scale"], params["u_min"])
+                if engine is None or (engine.preset, engine.tire_scale, engine.u_min, engine.crossfall) != \
+                        (params.get("preset"), params["tire_scale"], params["u_min"], params.get("crossfall", 0.0)):
+                    engine = LCVEngine(self.itf, params.get("preset"), params["tire_scale"], params["u_min"],
+                                       crossfall=params.get("crossfall", 0.0))
                 engine.set_state(state["engine"])
             self.params, self.inputs, self.engine = params, np.array(inputs, dtype=float), engine
             self._problem = self._feed_problem = False
