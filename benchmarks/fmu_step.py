@@ -3,7 +3,7 @@
 A 10 s run at 1 ms steps (10,000 steps) recording every output under
 ``fmpy.simulate_fmu``, for
 
-* ``LCV.fmu`` (pythonfmu) and two twins: a **stock pythonfmu FMU** with the same 45
+* ``LCV.fmu`` (pythonfmu) and two twins: a **stock pythonfmu FMU** with the same
   variables (a plain ``Fmi2Slave`` written here, built by ``pythonfmu build``, no loader,
   no guards: what any pythonfmu FMU of this interface costs -- the code under test cannot
   influence it), and the interface-only twin (LCV's own slave and loader machinery with no

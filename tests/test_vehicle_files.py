@@ -256,3 +256,10 @@ def test_dumps_loads_round_trip_exactly(vehicle):
 def test_presets_round_trip(name):
     v = load_preset(name)
     assert loads_vehicle(dumps_vehicle(v)) == v
+
+
+def test_a_description_with_control_characters_is_refused_in_the_api_too():
+    """It goes into modelDescription.xml, C sources and reports (issue 22)."""
+    v = load_preset("tractor_semitrailer")
+    with pytest.raises(VehicleError, match="control character U\\+0001"):
+        Vehicle("x", v.units, "a\x01b")

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from dataclasses import dataclass, field, replace
 from numbers import Integral, Real
 
@@ -265,6 +266,10 @@ class Vehicle:
         object.__setattr__(self, "units", units)
         if not isinstance(self.description, str):
             raise VehicleError("description", f"description must be text, got {self.description!r}")
+        bad = [ch for ch in self.description if unicodedata.category(ch) in ("Cc", "Cs", "Co", "Cn")]
+        if bad:
+            raise VehicleError("description", f"description must be printable text (it goes into XML, C and "
+                                              f"reports), got the control character U+{ord(bad[0]):04X}")
         seen_units: set[str] = set()
         seen_axles: set[str] = set()
         n = len(units)
