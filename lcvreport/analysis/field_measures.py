@@ -31,7 +31,7 @@ from ..model.vehicle import Vehicle
 from .exact import ManoeuvreError, ManoeuvreResponse, response
 from .geometry import point_lateral_map
 from .manoeuvres import G_MPS2, lane_change, lane_change_offset_m, pulse
-from .measures import steer_to_acceleration
+from .measures import steady_with_yaw_rate, steer_to_acceleration
 
 #: the RA(f) search band [Hz]
 RA_BAND_HZ = (0.1, 2.0)
@@ -243,17 +243,8 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
         raise ManoeuvreError(f"{vehicle.name} has no steered axle: no steer holds a turn")
     co = system_coefficients(vehicle)
     u = float(speed_mps)
-    S, b = co.S(u, tire_scale), co.B_delta(tire_scale)
-    n = vehicle.n_states
-    K = np.zeros((n + 1, n + 1))
-    K[:n, :n] = S
-    K[:n, n] = b
-    K[n, 1] = 1.0
     omega = u / radius_m
-    rhs = np.zeros(n + 1)
-    rhs[n] = omega
-    sol = np.linalg.solve(K, rhs)
-    x, delta = sol[:n], float(sol[n])
+    x, delta = steady_with_yaw_rate(vehicle, u, np.zeros(vehicle.n_states), omega, tire_scale)
     v = co.velocity_map(u) @ x                 # CG lateral velocity of every unit
 
     def radius(unit, xp):

@@ -249,10 +249,16 @@ def reference_points(vehicle: Vehicle) -> tuple[tuple[int, float], tuple[int, fl
     return (0, q.x_m), (last, vehicle.units[last].rearmost_axle.x_m)
 
 
-def trim(vehicle: Vehicle, speed_mps: float, F: np.ndarray, tire_scale: float = 1.0) -> Trim:
-    """Trimmed straight running under a constant generalized force F (SI).
+def steady_with_yaw_rate(vehicle: Vehicle, speed_mps: float, F, r1: float, tire_scale: float = 1.0
+                         ) -> tuple[np.ndarray, float]:
+    """The steady state and steer angle with the tractor's yaw rate held at ``r1`` [rad/s]:
+    ``S x + b delta + F = 0`` with ``x[1] = r1`` (the trim: r1 = 0; a steady turn: u/R).
 
-    Solves ``S x + b delta + F = 0`` with ``r1 = 0`` for ``x`` and ``delta``.
+    Returns
+    -------
+    x : numpy.ndarray, shape (2N,)
+    delta : float
+        [rad]
     """
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
@@ -262,10 +268,18 @@ def trim(vehicle: Vehicle, speed_mps: float, F: np.ndarray, tire_scale: float = 
     K = np.zeros((n + 1, n + 1))
     K[:n, :n] = S
     K[:n, n] = b
-    K[n, 1] = 1.0                       # r1 = 0
-    rhs = np.concatenate([-np.asarray(F, dtype=float), [0.0]])
+    K[n, 1] = 1.0
+    rhs = np.concatenate([-np.asarray(F, dtype=float), [float(r1)]])
     sol = np.linalg.solve(K, rhs)
-    x, delta = sol[:n], float(sol[n])
+    return sol[:n], float(sol[n])
+
+
+def trim(vehicle: Vehicle, speed_mps: float, F: np.ndarray, tire_scale: float = 1.0) -> Trim:
+    """Trimmed straight running under a constant generalized force F (SI).
+
+    Solves ``S x + b delta + F = 0`` with ``r1 = 0`` for ``x`` and ``delta``.
+    """
+    x, delta = steady_with_yaw_rate(vehicle, speed_mps, F, 0.0, tire_scale)
     (uq, xq), (up, xp) = reference_points(vehicle)
     nu = vehicle.n_units
     Theta = np.cumsum(x[nu + 1:])
