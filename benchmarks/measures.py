@@ -10,20 +10,29 @@ speed) for the 6-unit trains; the lane change, the pulse (YDC) and the steady tu
 <= 5 ms.
 
     python benchmarks/measures.py
+
+Timed with one BLAS thread (``OPENBLAS_NUM_THREADS=1`` unless set): on 12x12 matrices a
+second thread buys nothing and, with two threads on two cores, the pulse's long
+exponential scan ran at 8.9 ms instead of 2.0 (issue 21 makes one thread the package's
+default at its entry points).
 """
 from __future__ import annotations
 
-import time
-from pathlib import Path
+import os
 
-import numpy as np
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")    # before numpy is imported
 
-from lcvreport import load_preset, load_vehicle
-from lcvreport.analysis import field_measures, measures
-from lcvreport.analysis.modes import state_matrix
-from lcvreport.model.loads import load_vector, one_percent_rule
-from lcvreport.model.presets import PRESETS
-from lcvreport.units import kph_to_mps
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from lcvreport import load_preset, load_vehicle  # noqa: E402
+from lcvreport.analysis import field_measures, measures  # noqa: E402
+from lcvreport.analysis.modes import state_matrix  # noqa: E402
+from lcvreport.model.loads import load_vector, one_percent_rule  # noqa: E402
+from lcvreport.model.presets import PRESETS  # noqa: E402
+from lcvreport.units import kph_to_mps  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEED_MPS = kph_to_mps(88.0)
