@@ -265,3 +265,20 @@ def test_the_example_criteria_file_loads_and_says_it_is_not_a_standard():
     path = EXAMPLES.parent / "criteria" / "example_limits.toml"
     c = load_criteria(path)
     assert c.limits and all("not a standard" in lim.source for lim in c.limits.values())
+
+
+def test_a_misalignment_of_the_only_steered_axle_is_a_steer_and_crossfall_is_the_weight_component():
+    """Independent identities of the new input matrices: eps on the single steered axle
+    enters exactly as delta; the crossfall force on a unit is m g sin(atan(c)) at its CG,
+    so on a single unit it is a pure lateral force with no moment about the CG."""
+    v = load_preset("tractor_semitrailer")
+    co = system_coefficients(v)
+    steered = [i for i, a in enumerate(v.axles) if a.steered]
+    assert len(steered) == 1
+    np.testing.assert_array_equal(co.B_eps[:, steered[0]], co.B_delta())
+    one = load_vehicle(EXAMPLES / "b_double.toml")
+    from lcvreport.model.vehicle import Vehicle
+    truck = Vehicle("truck", (one.units[0].__class__(**{**one.units[0].__dict__, "rear_coupling_m": None}),))
+    cot = system_coefficients(truck)
+    assert cot.B_crossfall[0] == pytest.approx(truck.units[0].mass_kg * 9.80665, rel=1e-15)
+    assert cot.B_crossfall[1] == 0.0
