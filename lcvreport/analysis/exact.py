@@ -259,12 +259,14 @@ def _scan(Phi: np.ndarray, z0: np.ndarray, count: int) -> np.ndarray:
     Z = np.empty((count, z0.size))
     Z[0] = z0
     filled, P = 1, Phi
-    while filled < count:
-        take = min(filled, count - filled)
-        Z[filled:filled + take] = Z[:take] @ P.T
-        filled += take
-        if filled < count:
-            P = P @ P
+    # an unstable vehicle run long enough overflows: the callers refuse non-finite results
+    with np.errstate(over="ignore", invalid="ignore"):
+        while filled < count:
+            take = min(filled, count - filled)
+            Z[filled:filled + take] = Z[:take] @ P.T
+            filled += take
+            if filled < count:
+                P = P @ P
     return Z
 
 
