@@ -121,8 +121,9 @@ class ManoeuvreResponse:
     def matrix(self) -> np.ndarray:
         """Every signal at every sample, columns as :meth:`columns`."""
         keep = [j for j, n in enumerate(self.signal_names) if not n.startswith("Theta")]
-        lin = np.concatenate([seg.Z @ seg.C[keep].T for seg in self.segments])
-        return np.column_stack([self.time, lin, self._rear_offsets()])
+        with np.errstate(over="ignore", invalid="ignore"):     # an overflowed (unstable) run: callers refuse it
+            lin = np.concatenate([seg.Z @ seg.C[keep].T for seg in self.segments])
+            return np.column_stack([self.time, lin, self._rear_offsets()])
 
     def to_rows(self, names: list[str] | None = None) -> list[dict]:
         """Rows for a table or CSV (``time_s`` and the named signals, default all)."""
