@@ -27,6 +27,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``exact``            exact response to them (augmented exponential), extrema between samples
     ``field_measures``   RA peak, yaw damping (PBS style), HSTO, HSSO (SPEC 12)
     ``criteria``         the user's limits and the verdicts
+    ``tracking``         per-tire conicity and ply steer, fleet statistics of the trimmed offtracking
     ``discretize``       exact zero-order-hold discretization, its cache
     ``response``         TimeResponse, simulate, step_response (exact)
     ``modal``            modal superposition, exact and the thesis' method

@@ -175,6 +175,30 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--no-pdf", action="store_true", help="HTML only")
     rep.add_argument("--paper", default="letter", choices=("letter", "a4"), help="paper of the PDF (default letter)")
     rep.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
+    trk = sub.add_parser("tracking", help="straight-line tracking: per-tire conicity and ply steer (SPEC 13)")
+    tsub = trk.add_subparsers(dest="tracking_command", metavar="WHAT", parser_class=_Parser)
+    tsub.required = True
+    st = tsub.add_parser("stats", help="offtracking over a tire population: exact mean and SD, Monte Carlo lane "
+                                       "exceedance")
+    source(st, masses=False)
+    speed(st)
+    tires(st)
+    for opt, what in (("--conicity", "conicity force per tire [N]"), ("--ply-steer", "ply steer force per tire [N]"),
+                      ("--conicity-moment", "conicity moment per tire [N*m]"),
+                      ("--ply-steer-moment", "ply steer moment per tire [N*m]")):
+        st.add_argument(opt, metavar="DIST", required=opt in ("--conicity", "--ply-steer"),
+                        help=f"{what}: normal:MEAN:SD or uniform:LO:HI")
+    st.add_argument("--mounting", required=True, choices=("out", "in", "random"), help="serial side of every tire")
+    st.add_argument("--axles", metavar="A,B,...", help="axles whose tires are drawn (default: units 2..N)")
+    st.add_argument("--lane-width-m", type=float, default=3.66, metavar="W", help="lane width [m] (3.66)")
+    st.add_argument("--body-width-m", type=float, default=2.59, metavar="B", help="body width [m] (2.59)")
+    st.add_argument("--draws", type=int, default=1_000_000, metavar="N", help="Monte Carlo draws (1e6)")
+    st.add_argument("--seed", type=int, default=20110801, metavar="S", help="random seed (printed)")
+    st.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
+                    help=f"road crossfall [%%], in {RANGES['crossfall'].text()}")
+    st.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
+                    help="thrust angle of an axle [rad]; repeatable or comma-separated")
+    st.add_argument("--json", action="store_true", help="machine-readable output")
     sub.add_parser("presets", help="list the presets").add_argument("--json", action="store_true")
     return p
 
@@ -625,8 +649,49 @@ def _cmd_report(args, out: _Out) -> int:
     return 0
 
 
+def _cmd_tracking(args, out: _Out) -> int:
+    from .analysis.tracking import ZERO, TrackingError, parse_distribution, tracking_stats
+    v = _vehicle(args)
+    if not v.steered_axles:
+        raise UsageError(f"argument --vehicle: {v.name} has no steered axle: the trim needs one")
+    try:
+        dists = {name: (parse_distribution(getattr(args, name), "--" + name.replace("_", "-"))
+                        if getattr(args, name) is not None else ZERO)
+                 for name in ("conicity", "ply_steer", "conicity_moment", "ply_steer_moment")}
+    except TrackingError as exc:
+        raise UsageError(f"argument {exc}") from None
+    if not 1 <= args.draws <= 10_000_000:
+        raise UsageError(f"argument --draws: must be in [1, 1e7], got {args.draws}")
+    for opt, val in (("--lane-width-m", args.lane_width_m), ("--body-width-m", args.body_width_m)):
+        if not (math.isfinite(val) and 0 < val <= 10):
+            raise UsageError(f"argument {opt}: must be in (0, 10] m, got {val:g}")
+    axles = [a.strip() for a in args.axles.split(",")] if args.axles else None
+    src = _sources(args, v)
+    try:
+        F = src.vector(v, args.tire_scale) if src else None
+        s = tracking_stats(v, _speed_mps(args), dists["conicity"], dists["ply_steer"], args.mounting,
+                           dists["conicity_moment"], dists["ply_steer_moment"], axles, args.lane_width_m,
+                           args.body_width_m, args.draws, args.seed, F, args.tire_scale)
+    except TrackingError as exc:
+        raise UsageError(f"argument: {exc}") from None
+    doc = s.to_dict()
+    if args.json:
+        out.json(doc)
+        return 0
+    out.line(f"{v.name} at {_speed_text(args)}: trimmed offtracking over the tire population (seed {s.seed}, "
+             f"{s.draws} draws)")
+    out.line(f"  offtracking [m]      mean {s.offtracking_mean_m: .6g}  sd {s.offtracking_sd_m:.6g}  (exact)")
+    out.line(f"  trim steer [rad]     mean {s.trim_delta_mean_rad: .6g}  sd {s.trim_delta_sd_rad:.6g}  (exact)")
+    out.line("  quantiles [m]        " + "  ".join(f"{q:g}: {val:.6g}" for q, val in s.quantiles_m.items()))
+    lo, hi = s.exceedance_ci95
+    out.line(f"  P(|offtracking| > {s.margin_m:.4g} m) = {s.exceedance_probability:.6g}  (95 % CI {lo:.3g} .. "
+             f"{hi:.3g}, Monte Carlo)")
+    return 0
+
+
 COMMANDS = {"presets": _cmd_presets, "eig": _cmd_eig, "matrices": _cmd_matrices, "steady": _cmd_steady,
-            "simulate": _cmd_simulate, "measures": _cmd_measures, "fmu": _cmd_fmu, "report": _cmd_report}
+            "simulate": _cmd_simulate, "measures": _cmd_measures, "fmu": _cmd_fmu, "report": _cmd_report,
+            "tracking": _cmd_tracking}
 
 
 def run(argv: Sequence[str] | None = None, out=None) -> int:

@@ -1,0 +1,312 @@
+"""Straight-line tracking: per-tire conicity and ply steer, and fleet statistics (SPEC section 13).
+
+A tire's conicity force points toward its serial side (the side with the DOT code), so it
+flips in the vehicle frame with the mounting; its ply steer force does not.  A tire
+position is ``<axle>:<slot>``: ``left``, ``right`` on two-tire axles, ``left_outer``,
+``left_inner``, ``right_inner``, ``right_outer`` on four-tire axles, ``t1 .. tn``
+otherwise (the first half on the left).  A left tire mounted serial side ``out`` faces -y,
+``in`` faces +y; a right tire the opposite.  Axle P = sum over its tires of
+(ply_steer_N + s conicity_N), s = +1 when the serial side faces +y, else -1; T likewise
+with the moments.
+
+The trimmed offtracking and trim steer (SPEC section 8) are linear in the axle P and T,
+so their mean and standard deviation over independent random tires are exact sums;
+quantiles and the probability of leaving the lane margin come from a Monte Carlo with a
+fixed seed.
+
+Examples
+--------
+>>> slots_of(4)
+('left_outer', 'left_inner', 'right_inner', 'right_outer')
+>>> serial_sign("left_inner", "out"), serial_sign("right", "out")
+(-1.0, 1.0)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.builder import system_coefficients
+from ..model.vehicle import Vehicle
+from .measures import trim
+
+#: the default lane and body widths [m] (the thesis' 12 ft lane and 102 in trailer)
+LANE_WIDTH_M = 3.66
+BODY_WIDTH_M = 2.59
+#: default Monte Carlo draws and seed
+DRAWS = 1_000_000
+SEED = 20110801
+#: quantiles reported [-]
+QUANTILES = (0.01, 0.05, 0.5, 0.95, 0.99)
+
+
+class TrackingError(ValueError):
+    """A bad tire position, distribution or mounting; the message names it."""
+
+
+def slots_of(tires: int) -> tuple[str, ...]:
+    """The tire positions of an axle with ``tires`` tires."""
+    if tires == 2:
+        return ("left", "right")
+    if tires == 4:
+        return ("left_outer", "left_inner", "right_inner", "right_outer")
+    return tuple(f"t{k + 1}" for k in range(tires))
+
+
+def _side(slot: str, tires: int) -> float:
+    """-1 for a tire on the left (-y) side, +1 on the right."""
+    if slot.startswith("left"):
+        return -1.0
+    if slot.startswith("right"):
+        return 1.0
+    k = int(slot[1:])
+    if tires % 2:
+        raise TrackingError(f"slot {slot}: an axle with {tires} tires has no left and right half; give each tire's "
+                            "serial side as +y or -y")
+    return -1.0 if k <= tires // 2 else 1.0
+
+
+def serial_sign(slot: str, mounting: str, tires: int = 2) -> float:
+    """s = +1 when the serial side of the tire in ``slot`` mounted ``out`` or ``in`` faces +y."""
+    if mounting not in ("out", "in"):
+        raise TrackingError(f"mounting must be out or in, got {mounting!r}")
+    side = _side(slot, tires if not slot.startswith(("left", "right")) else 2)
+    return side if mounting == "out" else -side
+
+
+@dataclass(frozen=True)
+class Distribution:
+    """``normal:MEAN:SD`` or ``uniform:LO:HI`` (per tire, N or N*m)."""
+
+    kind: str
+    a: float
+    b: float
+
+    @property
+    def mean(self) -> float:
+        return self.a if self.kind == "normal" else 0.5 * (self.a + self.b)
+
+    @property
+    def variance(self) -> float:
+        return self.b ** 2 if self.kind == "normal" else (self.b - self.a) ** 2 / 12.0
+
+    def draw(self, rng: np.random.Generator, shape) -> np.ndarray:
+        if self.kind == "normal":
+            return rng.normal(self.a, self.b, shape)
+        return rng.uniform(self.a, self.b, shape)
+
+
+ZERO = Distribution("normal", 0.0, 0.0)
+
+
+def parse_distribution(text: str, what: str) -> Distribution:
+    """``normal:MEAN:SD`` (SD >= 0) or ``uniform:LO:HI`` (LO <= HI), finite, |values| <= 1e6."""
+    parts = text.split(":")
+    try:
+        if len(parts) != 3 or parts[0] not in ("normal", "uniform"):
+            raise ValueError
+        a, b = float(parts[1]), float(parts[2])
+    except ValueError:
+        raise TrackingError(f"{what}: expected normal:MEAN:SD or uniform:LO:HI, got {text!r}") from None
+    if not (math.isfinite(a) and math.isfinite(b)) or max(abs(a), abs(b)) > 1e6:
+        raise TrackingError(f"{what}: numbers must be finite and within 1e6, got {text!r}")
+    if parts[0] == "normal" and b < 0:
+        raise TrackingError(f"{what}: SD must be >= 0, got {b:g}")
+    if parts[0] == "uniform" and b < a:
+        raise TrackingError(f"{what}: HI must be >= LO, got {text!r}")
+    return Distribution(parts[0], a, b)
+
+
+def sensitivities(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+    """``g`` with ``[offtracking_m, trim_delta_rad] = g @ [P_axles (N), T_axles (N*m)]``, shape (2, 2 n_axles)."""
+    co = system_coefficients(vehicle)
+    cols = [co.B_P[:, j] for j in range(len(vehicle.axles))] + [co.B_T[:, j] for j in range(len(vehicle.axles))]
+    g = np.zeros((2, len(cols)))
+    for k, F in enumerate(cols):
+        tr = trim(vehicle, speed_mps, F, tire_scale)
+        g[:, k] = tr.offtracking_m, tr.delta_rad
+    return g
+
+
+@dataclass(frozen=True)
+class TireSlot:
+    """One tire position: its axle (index into :attr:`Vehicle.axles`), slot name, side."""
+
+    axle: int
+    axle_name: str
+    slot: str
+    side: float
+
+    @property
+    def position(self) -> str:
+        return f"{self.axle_name}:{self.slot}"
+
+
+def tire_slots(vehicle: Vehicle, axles: list[str] | None = None) -> list[TireSlot]:
+    """Every tire position of the named axles (default: every axle of units 2..N)."""
+    names = vehicle.axle_names
+    if axles is None:
+        chosen = [j for j, i in enumerate(vehicle.axle_units) if i >= 1]
+    else:
+        unknown = [a for a in axles if a not in names]
+        if unknown:
+            raise TrackingError(f"unknown axle {unknown[0]!r} of {vehicle.name}; valid: {', '.join(names)}")
+        chosen = [names.index(a) for a in axles]
+    out = []
+    for j in chosen:
+        a = vehicle.axles[j]
+        for slot in slots_of(a.tires):
+            out.append(TireSlot(j, a.name, slot, _side(slot, a.tires)))
+    return out
+
+
+def axle_residuals(vehicle: Vehicle, mounted: list[dict]):
+    """The per-axle residual loads of mounted tires.
+
+    Parameters
+    ----------
+    mounted : list of dict
+        ``position`` (``axle:slot``), ``conicity_N``, ``ply_steer_N``, optional
+        ``conicity_moment_Nm``, ``ply_steer_moment_Nm``, and ``serial_side`` (``out``, ``in``).
+
+    Returns
+    -------
+    lcvreport.model.loads.ResidualLoads
+        P [N] and T [N*m] by axle (only the axles that carry a tire).
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> v = load_preset("tractor_semitrailer")
+    >>> r = axle_residuals(v, [dict(position="11:left", conicity_N=100.0, ply_steer_N=30.0, serial_side="out"),
+    ...                        dict(position="11:right", conicity_N=100.0, ply_steer_N=30.0, serial_side="out")])
+    >>> r.P_N                       # conicity cancels, ply steer doubles
+    {'11': 60.0}
+    """
+    from ..model.loads import ResidualLoads
+    names = vehicle.axle_names
+    P, T, seen = {}, {}, set()
+    for tire in mounted:
+        axle, _, slot = str(tire["position"]).partition(":")
+        if axle not in names:
+            raise TrackingError(f"position {tire['position']!r}: unknown axle {axle!r}; valid: {', '.join(names)}")
+        n_tires = vehicle.axles[names.index(axle)].tires
+        if slot not in slots_of(n_tires):
+            raise TrackingError(f"position {tire['position']!r}: axle {axle} has the slots "
+                                f"{', '.join(slots_of(n_tires))}")
+        if tire["position"] in seen:
+            raise TrackingError(f"position {tire['position']!r} is filled twice")
+        seen.add(tire["position"])
+        s = serial_sign(slot, tire["serial_side"], n_tires)
+        P[axle] = P.get(axle, 0.0) + float(tire.get("ply_steer_N", 0.0)) + s * float(tire.get("conicity_N", 0.0))
+        T[axle] = T.get(axle, 0.0) + float(tire.get("ply_steer_moment_Nm", 0.0)) + \
+            s * float(tire.get("conicity_moment_Nm", 0.0))
+    return ResidualLoads(P, T)
+
+
+@dataclass(frozen=True)
+class TrackingStats:
+    """Trimmed offtracking and trim steer over a tire population (SPEC section 13)."""
+
+    offtracking_mean_m: float
+    offtracking_sd_m: float
+    trim_delta_mean_rad: float
+    trim_delta_sd_rad: float
+    quantiles_m: dict
+    exceedance_probability: float
+    exceedance_ci95: tuple
+    draws: int
+    seed: int
+    margin_m: float
+    samples_m: np.ndarray
+
+    def to_dict(self) -> dict:
+        return {"offtracking_m": {"mean": self.offtracking_mean_m, "sd": self.offtracking_sd_m,
+                                  "quantiles": {f"{q:g}": v for q, v in self.quantiles_m.items()}},
+                "trim_delta_rad": {"mean": self.trim_delta_mean_rad, "sd": self.trim_delta_sd_rad},
+                "exceedance": {"probability": self.exceedance_probability, "ci95": list(self.exceedance_ci95),
+                               "draws": self.draws},
+                "margin_m": self.margin_m, "seed": self.seed}
+
+
+def _wilson(k: int, n: int) -> tuple[float, float]:
+    """95 % Wilson score interval of a binomial proportion k/n."""
+    z = 1.959963984540054
+    p = k / n
+    den = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / den
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return (0.0 if k == 0 else max(0.0, centre - half)), (1.0 if k == n else min(1.0, centre + half))
+
+
+def tracking_stats(vehicle: Vehicle, speed_mps: float, conicity: Distribution, ply_steer: Distribution,
+                   mounting: str = "out", conicity_moment: Distribution = ZERO, ply_steer_moment: Distribution = ZERO,
+                   axles: list[str] | None = None, lane_width_m: float = LANE_WIDTH_M,
+                   body_width_m: float = BODY_WIDTH_M, draws: int = DRAWS, seed: int = SEED,
+                   F_const: np.ndarray | None = None, tire_scale: float = 1.0) -> TrackingStats:
+    """Mean and standard deviation (exact) and quantiles and lane exceedance (Monte Carlo)
+    of the trimmed offtracking over tires drawn independently from the distributions.
+
+    Parameters
+    ----------
+    mounting : {"out", "in", "random"}
+        Serial side of every tire (random: out or in with probability 1/2 each).
+    F_const : numpy.ndarray, optional
+        A constant generalized force added (crossfall, misalignment: SI).
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> s = tracking_stats(load_preset("tractor_semitrailer"), 24.4444, parse_distribution("normal:0:100", "c"),
+    ...                    parse_distribution("normal:50:50", "p"), draws=1000)
+    >>> s.draws, s.offtracking_sd_m > 0
+    (1000, True)
+    """
+    if mounting not in ("out", "in", "random"):
+        raise TrackingError(f"mounting must be out, in or random, got {mounting!r}")
+    margin = 0.5 * (lane_width_m - body_width_m)
+    if not (math.isfinite(margin) and margin > 0):
+        raise TrackingError(f"the lane ({lane_width_m:g} m) must be wider than the body ({body_width_m:g} m)")
+    slots = tire_slots(vehicle, axles)
+    if not slots:
+        raise TrackingError("no tire positions to draw")
+    g = sensitivities(vehicle, speed_mps, tire_scale)
+    na = len(vehicle.axles)
+    gP = np.array([g[:, s.axle] for s in slots])            # (tires, 2): per N of the tire's force on its axle
+    gT = np.array([g[:, na + s.axle] for s in slots])
+    const = np.zeros(2)
+    if F_const is not None:
+        tr = trim(vehicle, speed_mps, F_const, tire_scale)
+        const = np.array([tr.offtracking_m, tr.delta_rad])
+    if mounting == "random":
+        Es = np.zeros(len(slots))
+    else:
+        Es = np.array([s.side if mounting == "out" else -s.side for s in slots])
+    # exact moments: per tire X = gP (p + s c) + gT (pm + s cm), tires independent
+    mean = const + (gP * (ply_steer.mean + Es * conicity.mean)[:, None]).sum(0) + \
+        (gT * (ply_steer_moment.mean + Es * conicity_moment.mean)[:, None]).sum(0)
+    var_sc = conicity.variance + (1 - Es ** 2) * conicity.mean ** 2        # Var(s c)
+    var_scm = conicity_moment.variance + (1 - Es ** 2) * conicity_moment.mean ** 2
+    cov_c_cm = (1 - Es ** 2) * conicity.mean * conicity_moment.mean        # Cov(s c, s cm)
+    var = (gP ** 2 * (ply_steer.variance + var_sc)[:, None]).sum(0) + \
+        (gT ** 2 * (ply_steer_moment.variance + var_scm)[:, None]).sum(0) + \
+        (2 * gP * gT * cov_c_cm[:, None]).sum(0)
+    # Monte Carlo in batches (one product per batch)
+    rng = np.random.default_rng(seed)
+    n_t = len(slots)
+    samples = np.empty(draws)
+    batch = max(1, min(draws, 2_000_000 // max(n_t, 1)))
+    done = 0
+    while done < draws:
+        b = min(batch, draws - done)
+        s = rng.choice((-1.0, 1.0), size=(b, n_t)) if mounting == "random" else np.broadcast_to(Es, (b, n_t))
+        P = ply_steer.draw(rng, (b, n_t)) + s * conicity.draw(rng, (b, n_t))
+        T = ply_steer_moment.draw(rng, (b, n_t)) + s * conicity_moment.draw(rng, (b, n_t))
+        samples[done:done + b] = P @ gP[:, 0] + T @ gT[:, 0] + const[0]
+        done += b
+    k = int(np.sum(np.abs(samples) > margin))
+    return TrackingStats(float(mean[0]), float(math.sqrt(var[0])), float(mean[1]), float(math.sqrt(var[1])),
+                         {q: float(v) for q, v in zip(QUANTILES, np.quantile(samples, QUANTILES))},
+                         k / draws, _wilson(k, draws), int(draws), int(seed), float(margin), samples)
