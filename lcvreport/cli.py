@@ -138,6 +138,8 @@ def build_parser() -> argparse.ArgumentParser:
                              f"{RANGES['misalignment'].text()}; repeatable or comma-separated")
         sp.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
                         help=f"road crossfall [%%], positive falling toward +y, in {RANGES['crossfall'].text()}")
+        sp.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML: position, conicity_N, "
+                                                         "ply_steer_N, serial_side[, moments]): their axle P and T")
 
     sim = sub.add_parser("simulate", help="exact response from rest to a steer input and residual sources, "
                                           "streamed as CSV (or JSON), SI units")
@@ -335,6 +337,16 @@ def _sources(args: argparse.Namespace, vehicle):
                 raise UsageError(f"argument --misalignment: the angle of axle {a} must be in "
                                  f"{RANGES['misalignment'].text()}, got {value}")
             eps[a] = val
+    if getattr(args, "tires", None):
+        from .analysis.tracking import TrackingError, axle_residuals, read_mounted_tires
+        try:
+            loads = axle_residuals(vehicle, read_mounted_tires(args.tires))
+        except TrackingError as exc:
+            raise UsageError(f"argument --tires: {exc}") from None
+        for a, val in loads.P_N.items():
+            P[a] = P.get(a, 0.0) + val
+        for a, val in loads.T_Nm.items():
+            T[a] = T.get(a, 0.0) + val
     crossfall = getattr(args, "crossfall_percent", None) or 0.0
     return ResidualSources(ResidualLoads(P, T), eps, crossfall)
 

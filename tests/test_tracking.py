@@ -140,3 +140,37 @@ def test_lcv_tracking_stats_json():
     assert set(doc) >= {"offtracking_m", "trim_delta_rad", "exceedance", "margin_m"}
     assert set(doc["offtracking_m"]) == {"mean", "sd", "quantiles"} and doc["exceedance"]["draws"] == 20000
     assert len(doc["exceedance"]["ci95"]) == 2
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".toml"])
+def test_tires_file_gives_the_axle_loads_a_hand_computation_gives(tmp_path, suffix):
+    """Left outer serial side out (-y): 30 - 120; right outer in (-y): -10 - 80; axle 61 P = -180 N,
+    T = (2 - 8) + (1 - 6) = -11 N*m: the same measures as --residual 61=-180,-11."""
+    path = tmp_path / f"tires{suffix}"
+    if suffix == ".csv":
+        path.write_text("position,conicity_N,ply_steer_N,serial_side,conicity_moment_Nm,ply_steer_moment_Nm\n"
+                        "61:left_outer,120,30,out,8,2\n61:right_outer,80,-10,in,6,1\n")
+    else:
+        path.write_text('[[tires]]\nposition = "61:left_outer"\nconicity_N = 120.0\nply_steer_N = 30.0\n'
+                        'serial_side = "out"\nconicity_moment_Nm = 8.0\nply_steer_moment_Nm = 2.0\n'
+                        '[[tires]]\nposition = "61:right_outer"\nconicity_N = 80.0\nply_steer_N = -10.0\n'
+                        'serial_side = "in"\nconicity_moment_Nm = 6.0\nply_steer_moment_Nm = 1.0\n')
+    run = lambda *a: json.loads(subprocess.run([sys.executable, "-m", "lcvreport.cli", "measures", "--preset",  # noqa
+                                                "aucnat", "--speed-kph", "88", *a, "--json"],
+                                               capture_output=True, text=True).stdout)
+    assert run("--tires", str(path))["trim"] == run("--residual", "61=-180,-11")["trim"]
+
+
+@pytest.mark.parametrize("content, fragment", [
+    ("position,conicity_N,ply_steer_N\n61:left_outer,1,2\n", "missing 'serial_side'"),
+    ("position,conicity_N,ply_steer_N,serial_side\n61:left_outer,x,2,out\n", "must be a number"),
+    ("position,conicity_N,ply_steer_N,serial_side\n61:left_outer,1,2,up\n", "serial_side must be out or in"),
+    ("position,conicity_N,ply_steer_N,serial_side\n99:left,1,2,out\n", "unknown axle '99'"),
+    ("position,conicity_N,ply_steer_N,serial_side\n61:left_outer,inf,2,out\n", "finite"),
+])
+def test_a_bad_tires_file_is_one_line_exit_2(tmp_path, content, fragment):
+    path = tmp_path / "tires.csv"
+    path.write_text(content)
+    p = subprocess.run([sys.executable, "-m", "lcvreport.cli", "measures", "--preset", "aucnat", "--speed-kph", "88",
+                        "--tires", str(path)], capture_output=True, text=True)
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1 and fragment in p.stderr, p.stderr

@@ -206,6 +206,65 @@ def axle_residuals(vehicle: Vehicle, mounted: list[dict]):
     return ResidualLoads(P, T)
 
 
+#: columns of a mounted-tires file
+TIRE_COLUMNS = ("position", "conicity_N", "ply_steer_N", "serial_side")
+TIRE_OPTIONAL = ("id", "conicity_moment_Nm", "ply_steer_moment_Nm")
+
+
+def read_mounted_tires(path) -> list[dict]:
+    """Mounted tires from a CSV (header ``position,conicity_N,ply_steer_N,serial_side``
+    and optionally ``id``, ``conicity_moment_Nm``, ``ply_steer_moment_Nm``) or a TOML file
+    (``[[tires]]`` tables with the same keys).
+
+    Raises
+    ------
+    TrackingError
+        Unreadable file, unknown or missing columns, non-numbers, non-finite values,
+        a serial side other than out or in.
+    """
+    import csv
+    import tomllib
+    from pathlib import Path
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise TrackingError(f"{path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") from None
+    if path.suffix.lower() == ".toml":
+        try:
+            rows = tomllib.loads(text).get("tires")
+        except tomllib.TOMLDecodeError as exc:
+            raise TrackingError(f"{path}: not valid TOML: {exc}") from None
+        if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
+            raise TrackingError(f"{path}: expected [[tires]] tables")
+    else:
+        rows = list(csv.DictReader(text.splitlines()))
+    out = []
+    for k, row in enumerate(rows, start=1):
+        unknown = set(row) - set(TIRE_COLUMNS) - set(TIRE_OPTIONAL)
+        missing = [c for c in TIRE_COLUMNS if c not in row or row[c] in (None, "")]
+        if unknown or missing:
+            raise TrackingError(f"{path}: tire {k}: " + (f"unknown column {sorted(unknown)[0]!r}" if unknown else
+                                                          f"missing {missing[0]!r}") +
+                                f"; columns: {', '.join(TIRE_COLUMNS + TIRE_OPTIONAL)}")
+        tire = {"position": str(row["position"]).strip(), "serial_side": str(row["serial_side"]).strip()}
+        if tire["serial_side"] not in ("out", "in"):
+            raise TrackingError(f"{path}: tire {k}: serial_side must be out or in, got {tire['serial_side']!r}")
+        for key in ("conicity_N", "ply_steer_N", "conicity_moment_Nm", "ply_steer_moment_Nm"):
+            if key in row and row[key] not in (None, ""):
+                try:
+                    val = float(row[key])
+                except (TypeError, ValueError):
+                    raise TrackingError(f"{path}: tire {k}: {key} must be a number, got {row[key]!r}") from None
+                if not math.isfinite(val) or abs(val) > 1e6:
+                    raise TrackingError(f"{path}: tire {k}: {key} must be finite and within 1e6, got {row[key]!r}")
+                tire[key] = val
+        out.append(tire)
+    if not out:
+        raise TrackingError(f"{path}: no tires")
+    return out
+
+
 @dataclass(frozen=True)
 class TrackingStats:
     """Trimmed offtracking and trim steer over a tire population (SPEC section 13)."""
