@@ -21,7 +21,7 @@ LAYERS = ["units", "ranges", "util", "model", "analysis", "thesis", "fmu", "repo
 #: masses (``load_preset(name, masses="unrounded")``)
 LAZY_UPWARD = {
     ("analysis.measures", "report.plotting"), ("analysis.response", "report.plotting"),
-    ("analysis.exact", "report.plotting"),
+    ("analysis.exact", "report.plotting"), ("analysis.tracking", "report.plotting"),
     ("thesis.studies", "report.plotting"), ("model.presets", "thesis.vehicles"),
 }
 

@@ -174,3 +174,14 @@ def test_a_bad_tires_file_is_one_line_exit_2(tmp_path, content, fragment):
     p = subprocess.run([sys.executable, "-m", "lcvreport.cli", "measures", "--preset", "aucnat", "--speed-kph", "88",
                         "--tires", str(path)], capture_output=True, text=True)
     assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1 and fragment in p.stderr, p.stderr
+
+
+def test_the_statistics_plot_themselves_with_the_margin_and_the_mean():
+    v = load_vehicle(EXAMPLES / "western_double.toml")
+    zero = parse_distribution("normal:0:0", "c")
+    s = tracking_stats(v, U88, zero, parse_distribution("normal:2000:9000", "p"), "out", draws=20_000, seed=3)
+    fig = s.plot()
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "trimmed offtracking [m]"
+    xs = sorted(line.get_xdata()[0] for line in ax.get_lines())
+    assert xs == pytest.approx(sorted([-s.margin_m, s.offtracking_mean_m, s.margin_m]))

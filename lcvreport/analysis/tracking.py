@@ -281,6 +281,11 @@ class TrackingStats:
     margin_m: float
     samples_m: np.ndarray
 
+    def plot(self, title: str = "Trimmed offtracking over the tire population"):
+        """Histogram of the Monte Carlo offtracking with the exact mean and the lane margins."""
+        from ..report.plotting import fig_offtracking_histogram
+        return fig_offtracking_histogram(self, title)
+
     def to_dict(self) -> dict:
         return {"offtracking_m": {"mean": self.offtracking_mean_m, "sd": self.offtracking_sd_m,
                                   "quantiles": {f"{q:g}": v for q, v in self.quantiles_m.items()}},

@@ -633,6 +633,25 @@ def fig_pulse(ydc, names: list[str], title: str) -> Figure:
     return fig
 
 
+def fig_offtracking_histogram(stats, title: str) -> Figure:
+    """The Monte Carlo offtracking [m] of :class:`lcvreport.analysis.tracking.TrackingStats`
+    as a histogram, the exact mean and the lane margins marked."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.0)
+    x = stats.samples_m
+    m = stats.margin_m
+    ax.hist(x, bins=120, color=PALETTE[0], alpha=0.8, density=True, label=f"{stats.draws} draws (seed {stats.seed})")
+    ax.axvline(stats.offtracking_mean_m, color="black", lw=1.0, label=f"mean {stats.offtracking_mean_m:.4g} m (exact)")
+    if abs(x).max() >= 0.5 * m:
+        for sgn in (-1, 1):
+            ax.axvline(sgn * m, color=PALETTE[1], ls="--", lw=1.0, label="lane margin ±%.3f m" % m if sgn > 0 else None)
+    ax.set_xlabel("trimmed offtracking [m]")
+    ax.set_ylabel("probability density [1/m]")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT)
+    ax.set_title(f"{title}: P(|offtracking| > {m:.3f} m) = {stats.exceedance_probability:.3g}", fontsize=9)
+    return fig
+
+
 def fig_bars(labels: list[str], groups: list[tuple[str, np.ndarray]], ylabel: str, title: str,
              height: float = 3.6, horizontal: bool = False) -> Figure:
     """Grouped bar chart (Figures 5-4, 5-8, 5-13, 5-18, 5-20; conicity sensitivity).
