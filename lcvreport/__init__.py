@@ -28,6 +28,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``field_measures``   RA peak, yaw damping (PBS style), HSTO, HSSO (SPEC 12)
     ``criteria``         the user's limits and the verdicts
     ``tracking``         per-tire conicity and ply steer, fleet statistics of the trimmed offtracking
+    ``placement``        which measured tire goes where: the exact mounting plan (a mixed-integer program)
     ``discretize``       exact zero-order-hold discretization, its cache
     ``response``         TimeResponse, simulate, step_response (exact)
     ``modal``            modal superposition, exact and the thesis' method

@@ -201,6 +201,22 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
                     help="thrust angle of an axle [rad]; repeatable or comma-separated")
     st.add_argument("--json", action="store_true", help="machine-readable output")
+    pl = tsub.add_parser("place", help="mounting plan of measured tires with the least trimmed offtracking "
+                                       "(exact, a mixed-integer program)")
+    source(pl, masses=False)
+    speed(pl)
+    tires(pl)
+    pl.add_argument("--tires", dest="measured_tires", required=True, metavar="TIRES.csv",
+                    help="measured tires: CSV id,conicity_N,ply_steer_N[,conicity_moment_Nm,ply_steer_moment_Nm]")
+    pl.add_argument("--positions", metavar="POS,POS,...",
+                    help="positions to fill, axle:slot (default: every tire position of units 2..N)")
+    pl.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
+                    help=f"road crossfall [%%], in {RANGES['crossfall'].text()}")
+    pl.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
+                    help="thrust angle of an axle [rad]; repeatable or comma-separated")
+    pl.add_argument("--draws", type=int, default=10_000, metavar="N", help="random placements to compare (1e4)")
+    pl.add_argument("--seed", type=int, default=20110801, metavar="S", help="seed of the random placements")
+    pl.add_argument("--json", action="store_true", help="machine-readable output")
     sub.add_parser("presets", help="list the presets").add_argument("--json", action="store_true")
     return p
 
@@ -661,7 +677,50 @@ def _cmd_report(args, out: _Out) -> int:
     return 0
 
 
+def _cmd_place(args, out: _Out) -> int:
+    from .analysis.placement import place_tires, read_measured_tires
+    from .analysis.tracking import TrackingError
+    v = _vehicle(args)
+    if not v.steered_axles:
+        raise UsageError(f"argument --vehicle: {v.name} has no steered axle: the trim needs one")
+    if not 1 <= args.draws <= 1_000_000:
+        raise UsageError(f"argument --draws: must be in [1, 1e6], got {args.draws}")
+    if not 0 <= args.seed < 2 ** 63:
+        raise UsageError(f"argument --seed: must be in [0, 2^63), got {args.seed}")
+    try:
+        tires = read_measured_tires(args.measured_tires)
+    except TrackingError as exc:
+        raise UsageError(f"argument --tires: {exc}") from None
+    positions = [p.strip() for p in args.positions.split(",")] if args.positions else None
+    src = _sources(args, v)
+    try:
+        F = src.vector(v, args.tire_scale) if src else None
+        pl = place_tires(v, _speed_mps(args), tires, positions, F, args.tire_scale, args.draws, args.seed)
+    except TrackingError as exc:
+        opt = "--positions" if str(exc).startswith("position") else "--tires"
+        raise UsageError(f"argument {opt}: {exc}") from None
+    doc = pl.to_dict()
+    if args.json:
+        out.json(doc)
+        return 0
+    out.line(f"{v.name} at {_speed_text(args)}: mounting plan of {len(tires)} tires with the least |trimmed "
+             f"offtracking| (then |trim steer|)")
+    out.line(f"  {'position':<18} {'tire':<14} serial side")
+    for row in pl.plan:
+        out.line(f"  {row['position']:<18} {row['tire']:<14} {row['serial_side']}")
+    r = doc["random_placements"]
+    out.line(f"  offtracking [m]   plan {pl.offtracking_m: .6g} (least possible >= {pl.lower_bound_m:.3g}; "
+             f"trim steer {pl.trim_delta_rad:.6g} rad)")
+    out.line(f"                    as listed, serial side out {pl.as_listed_offtracking_m: .6g} "
+             f"(trim steer {pl.as_listed_trim_delta_rad:.6g} rad)")
+    out.line(f"                    random placements: mean {r['mean']: .6g}  sd {r['sd']:.6g}  best |.| "
+             f"{r['best_abs']:.6g}  ({r['draws']} draws, seed {r['seed']})")
+    return 0
+
+
 def _cmd_tracking(args, out: _Out) -> int:
+    if args.tracking_command == "place":
+        return _cmd_place(args, out)
     from .analysis.tracking import ZERO, TrackingError, parse_distribution, tracking_stats
     v = _vehicle(args)
     if not v.steered_axles:

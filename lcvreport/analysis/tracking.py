@@ -92,7 +92,10 @@ class Distribution:
     def variance(self) -> float:
         return self.b ** 2 if self.kind == "normal" else (self.b - self.a) ** 2 / 12.0
 
-    def draw(self, rng: np.random.Generator, shape) -> np.ndarray:
+    def draw(self, rng: np.random.Generator, shape) -> np.ndarray | float:
+        """Draws of ``shape``; a point mass (SD 0, LO = HI) is its value, drawing nothing."""
+        if self.variance == 0.0:
+            return self.mean
         if self.kind == "normal":
             return rng.normal(self.a, self.b, shape)
         return rng.uniform(self.a, self.b, shape)
@@ -367,10 +370,95 @@ def tracking_stats(vehicle: Vehicle, speed_mps: float, conicity: Distribution, p
         b = min(batch, draws - done)
         s = rng.choice((-1.0, 1.0), size=(b, n_t)) if mounting == "random" else np.broadcast_to(Es, (b, n_t))
         P = ply_steer.draw(rng, (b, n_t)) + s * conicity.draw(rng, (b, n_t))
-        T = ply_steer_moment.draw(rng, (b, n_t)) + s * conicity_moment.draw(rng, (b, n_t))
-        samples[done:done + b] = P @ gP[:, 0] + T @ gT[:, 0] + const[0]
+        samples[done:done + b] = np.broadcast_to(P, (b, n_t)) @ gP[:, 0] + const[0]
+        if ply_steer_moment is not ZERO or conicity_moment is not ZERO:
+            T = ply_steer_moment.draw(rng, (b, n_t)) + s * conicity_moment.draw(rng, (b, n_t))
+            samples[done:done + b] += np.broadcast_to(T, (b, n_t)) @ gT[:, 0]
         done += b
     k = int(np.sum(np.abs(samples) > margin))
     return TrackingStats(float(mean[0]), float(math.sqrt(var[0])), float(mean[1]), float(math.sqrt(var[1])),
                          {q: float(v) for q, v in zip(QUANTILES, np.quantile(samples, QUANTILES))},
                          k / draws, _wilson(k, draws), int(draws), int(seed), float(margin), samples)
+
+
+#: keys of a tracking-statistics specification (``lcv report --tracking-stats``)
+STATS_KEYS = ("conicity", "ply_steer", "conicity_moment", "ply_steer_moment", "mounting", "draws", "seed",
+              "lane_width_m", "body_width_m")
+
+
+def parse_stats_spec(text: str) -> dict:
+    """``conicity=DIST,ply_steer=DIST,mounting=out|in|random[,conicity_moment=DIST,
+    ply_steer_moment=DIST,draws=N,seed=S,lane_width_m=W,body_width_m=B]`` as a checked dict
+    (distributions as text, numbers as numbers).
+
+    Examples
+    --------
+    >>> parse_stats_spec("conicity=normal:0:120,ply_steer=normal:40:60,mounting=random")["mounting"]
+    'random'
+    """
+    spec: dict = {}
+    for item in str(text).split(","):
+        key, eq, value = item.strip().partition("=")
+        if not eq or key not in STATS_KEYS:
+            raise TrackingError(f"expected KEY=VALUE with KEY one of {', '.join(STATS_KEYS)}, got {item.strip()!r}")
+        if key in spec:
+            raise TrackingError(f"{key} is given twice")
+        spec[key] = value.strip()
+    return check_stats_spec(spec)
+
+
+def check_stats_spec(spec: dict) -> dict:
+    """Check a tracking-statistics specification (see :func:`parse_stats_spec`); return it
+    with numbers converted.
+
+    Raises
+    ------
+    TrackingError
+        The key and the value that is wrong, and what is valid.
+    """
+    if not isinstance(spec, dict):
+        raise TrackingError(f"expected a dict with keys {', '.join(STATS_KEYS)}, got {spec!r}")
+    unknown = [k for k in spec if k not in STATS_KEYS]
+    if unknown:
+        raise TrackingError(f"unknown key {unknown[0]!r}; valid: {', '.join(STATS_KEYS)}")
+    for key in ("conicity", "ply_steer", "mounting"):
+        if key not in spec:
+            raise TrackingError(f"{key} is missing (conicity=DIST, ply_steer=DIST and mounting=out|in|random "
+                                "are needed)")
+    out = dict(spec)
+    for key in ("conicity", "ply_steer", "conicity_moment", "ply_steer_moment"):
+        if key in out:
+            parse_distribution(str(out[key]), key)
+    if out["mounting"] not in ("out", "in", "random"):
+        raise TrackingError(f"mounting must be out, in or random, got {out['mounting']!r}")
+    for key, lo, hi, kind in (("draws", 1, 10_000_000, int), ("seed", 0, 2 ** 63 - 1, int),
+                              ("lane_width_m", 0.0, 10.0, float), ("body_width_m", 0.0, 10.0, float)):
+        if key not in out:
+            continue
+        try:
+            val = kind(out[key])
+            if kind is int and isinstance(out[key], float) and out[key] != val:
+                raise ValueError
+        except (TypeError, ValueError):
+            raise TrackingError(f"{key} must be {'an integer' if kind is int else 'a number'}, got {out[key]!r}") \
+                from None
+        if not (math.isfinite(val) and (lo <= val <= hi if kind is int else lo < val <= hi)):
+            raise TrackingError(f"{key} must be in {'[' if kind is int else '('}{lo:g}, {hi:g}], got {out[key]!r}")
+        out[key] = val
+    margin = 0.5 * (out.get("lane_width_m", LANE_WIDTH_M) - out.get("body_width_m", BODY_WIDTH_M))
+    if margin <= 0:
+        raise TrackingError(f"the lane ({out.get('lane_width_m', LANE_WIDTH_M):g} m) must be wider than the body "
+                            f"({out.get('body_width_m', BODY_WIDTH_M):g} m)")
+    return out
+
+
+def stats_from_spec(vehicle: Vehicle, speed_mps: float, spec: dict, F_const: np.ndarray | None = None,
+                    tire_scale: float = 1.0) -> TrackingStats:
+    """:func:`tracking_stats` of a checked specification (:func:`check_stats_spec`)."""
+    spec = check_stats_spec(spec)
+    dist = {k: parse_distribution(str(spec[k]), k) if k in spec else ZERO
+            for k in ("conicity", "ply_steer", "conicity_moment", "ply_steer_moment")}
+    return tracking_stats(vehicle, speed_mps, dist["conicity"], dist["ply_steer"], spec["mounting"],
+                          dist["conicity_moment"], dist["ply_steer_moment"], None,
+                          spec.get("lane_width_m", LANE_WIDTH_M), spec.get("body_width_m", BODY_WIDTH_M),
+                          spec.get("draws", DRAWS), spec.get("seed", SEED), F_const, tire_scale)

@@ -44,11 +44,12 @@ class Assessment:
     _cache: dict = field(default_factory=dict, repr=False)
     sources: object = None          # ResidualSources beyond the 1 % rule (SPEC 11)
     criteria: object = None         # Criteria to judge the measures by
+    tracking: dict | None = None    # {"tires": mounted tires or None, "stats": a tracking-statistics spec or None}
 
     @classmethod
     def load(cls, preset: str | None = None, vehicle_file: str | None = None, speed_kph: float = 88.0,
              load_units=None, fast: bool = False, source: str | None = None, residuals: dict | None = None,
-             criteria_file: str | None = None) -> "Assessment":
+             criteria_file: str | None = None, tracking: dict | None = None) -> "Assessment":
         """From a preset name or a vehicle file; ``source`` names it for captions (default:
         the preset or the file's path); ``residuals`` (``P_N``, ``T_Nm``,
         ``misalignment_rad`` by axle, ``crossfall_percent``) and a criteria file optional."""
@@ -61,7 +62,8 @@ class Assessment:
         return cls(vehicle, float(speed_kph), tuple(load_units or ()), fast,
                    source or (f"preset {preset}" if preset is not None else str(vehicle_file)),
                    sources=sources if sources else None,
-                   criteria=load_criteria(criteria_file) if criteria_file else None)
+                   criteria=load_criteria(criteria_file) if criteria_file else None,
+                   tracking=tracking if tracking and (tracking.get("tires") or tracking.get("stats")) else None)
 
     @property
     def speed_mps(self) -> float:
@@ -276,6 +278,112 @@ class Assessment:
                                 height=1.2 + 0.32 * len(rows), horizontal=True)
         fig.lcv_data = self.sensitivity_rows()
         return fig
+
+    # ------------------------------------------------------------------ straight-line tracking (SPEC 13)
+    def _tire_force(self) -> np.ndarray:
+        """The generalized force of the mounted tires alone (SI)."""
+        from ..analysis.tracking import axle_residuals
+        from ..model.loads import ResidualSources
+        return ResidualSources(axle_residuals(self.vehicle, self.tracking["tires"])).vector(self.vehicle)
+
+    def _other_force(self) -> np.ndarray | None:
+        """Every residual source but the mounted tires (SI), or None."""
+        if self.sources is None:
+            return None
+        F = self.sources.vector(self.vehicle)
+        if self.tracking and self.tracking.get("tires"):
+            F = F - self._tire_force()
+        return F
+
+    @cached_property
+    def tracking_stats(self):
+        """:class:`lcvreport.analysis.tracking.TrackingStats` of the report's specification, or None."""
+        from ..analysis.tracking import stats_from_spec
+        if not self.tracking or not self.tracking.get("stats") or not self.vehicle.steered_axles:
+            return None
+        spec = dict(self.tracking["stats"])
+        if self.fast:
+            spec.setdefault("draws", 20_000)
+        return stats_from_spec(self.vehicle, self.speed_mps, spec, self._other_force())
+
+    def tracking_stats_rows(self) -> list[dict]:
+        s = self.tracking_stats
+        spec = self.tracking["stats"]
+        lo, hi = s.exceedance_ci95
+        rows = [{"quantity": "population (per tire)", "value": ", ".join(f"{k} {spec[k]}" for k in
+                 ("conicity", "ply_steer", "conicity_moment", "ply_steer_moment") if k in spec) +
+                 f"; mounting {spec['mounting']}", "unit": "N, N·m", "how": "given"},
+                {"quantity": "trimmed offtracking, mean", "value": f"{s.offtracking_mean_m:.6g}", "unit": "m",
+                 "how": "exact"},
+                {"quantity": "trimmed offtracking, standard deviation", "value": f"{s.offtracking_sd_m:.6g}",
+                 "unit": "m", "how": "exact"},
+                {"quantity": "trim steer, mean", "value": f"{s.trim_delta_mean_rad:.6g}", "unit": "rad", "how": "exact"},
+                {"quantity": "trim steer, standard deviation", "value": f"{s.trim_delta_sd_rad:.6g}", "unit": "rad",
+                 "how": "exact"}]
+        rows += [{"quantity": f"offtracking, {100 * q:g} % quantile", "value": f"{val:.6g}", "unit": "m",
+                  "how": f"Monte Carlo, {s.draws} draws, seed {s.seed}"} for q, val in s.quantiles_m.items()]
+        rows.append({"quantity": f"P(|offtracking| > margin {s.margin_m:.4g} m)",
+                     "value": f"{s.exceedance_probability:.6g} (95 % CI {lo:.3g} .. {hi:.3g})", "unit": "-",
+                     "how": f"Monte Carlo, {s.draws} draws, seed {s.seed}"})
+        return rows
+
+    def fig_tracking_histogram(self):
+        fig = self.tracking_stats.plot(f"Trimmed offtracking of {self.at} over the tire population")
+        s = self.tracking_stats
+        edges = np.quantile(s.samples_m, np.linspace(0, 1, 101))
+        fig.lcv_data = [{"percentile": k, "offtracking_m": float(e)} for k, e in enumerate(edges)]
+        return fig
+
+    def mounted_tire_rows(self) -> list[dict]:
+        """The mounted tires and their axles' P and T (SI)."""
+        from ..analysis.tracking import axle_residuals
+        tires = self.tracking["tires"]
+        loads = axle_residuals(self.vehicle, tires)
+        rows = [{"position": t["position"], "tire": t.get("id", ""), "serial_side": t["serial_side"],
+                 "conicity_N": t.get("conicity_N", 0.0), "ply_steer_N": t.get("ply_steer_N", 0.0),
+                 "conicity_moment_Nm": t.get("conicity_moment_Nm", 0.0),
+                 "ply_steer_moment_Nm": t.get("ply_steer_moment_Nm", 0.0)} for t in tires]
+        rows += [{"position": f"axle {a} (sum)", "tire": "", "serial_side": "", "conicity_N": "",
+                  "ply_steer_N": "", "P_N": loads.P_N[a], "T_Nm": loads.T_Nm.get(a, 0.0)} for a in loads.P_N]
+        return rows
+
+    @cached_property
+    def placement(self):
+        """The mounting plan of the mounted tires over their own positions
+        (:func:`lcvreport.analysis.placement.place_tires`), or None."""
+        from ..analysis.placement import place_tires
+        if not self.tracking or not self.tracking.get("tires") or not self.vehicle.steered_axles:
+            return None
+        tires = self.tracking["tires"]
+        measured = [{"id": t.get("id") or t["position"], **{k: t[k] for k in ("conicity_N", "ply_steer_N",
+                    "conicity_moment_Nm", "ply_steer_moment_Nm") if k in t}} for t in tires]
+        return place_tires(self.vehicle, self.speed_mps, measured, [t["position"] for t in tires],
+                           self._other_force(), draws=2_000 if self.fast else 10_000)
+
+    def placement_rows(self) -> list[dict]:
+        by_pos = {t["position"]: t for t in self.tracking["tires"]}
+        return [{"position": r["position"], "tire": r["tire"], "serial_side": r["serial_side"],
+                 "was": f"{by_pos[r['position']].get('id') or r['position']} "
+                        f"{by_pos[r['position']]['serial_side']}"} for r in self.placement.plan]
+
+    def tracking_comparison_rows(self) -> list[dict]:
+        """Offtracking of the tires as mounted, as planned and over random placements, against the margin."""
+        from ..analysis.tracking import BODY_WIDTH_M, LANE_WIDTH_M
+        spec = (self.tracking or {}).get("stats") or {}
+        margin = 0.5 * (float(spec.get("lane_width_m", LANE_WIDTH_M)) - float(spec.get("body_width_m", BODY_WIDTH_M)))
+        pl = self.placement
+        F_other = self._other_force()
+        as_mounted = measures.trim(self.vehicle, self.speed_mps, self._tire_force() +
+                                   (0 if F_other is None else F_other))
+        r = pl.to_dict()["random_placements"]
+        return [{"tires": "as mounted (the file)", "offtracking_m": as_mounted.offtracking_m,
+                 "trim_steer_rad": as_mounted.delta_rad, "share_of_margin": abs(as_mounted.offtracking_m) / margin},
+                {"tires": "the plan", "offtracking_m": pl.offtracking_m, "trim_steer_rad": pl.trim_delta_rad,
+                 "share_of_margin": abs(pl.offtracking_m) / margin},
+                {"tires": f"random placements, mean ({r['draws']} draws, seed {r['seed']})",
+                 "offtracking_m": r["mean"], "trim_steer_rad": "", "share_of_margin": abs(r["mean"]) / margin},
+                {"tires": "random placements, standard deviation", "offtracking_m": r["sd"], "trim_steer_rad": "",
+                 "share_of_margin": ""}]
 
     # ------------------------------------------------------------------ summary
     no_steer_note = ("*Not computed: the vehicle has no steered axle, so there is no steer input to respond to "

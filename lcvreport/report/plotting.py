@@ -644,6 +644,10 @@ def fig_offtracking_histogram(stats, title: str) -> Figure:
     if abs(x).max() >= 0.5 * m:
         for sgn in (-1, 1):
             ax.axvline(sgn * m, color=PALETTE[1], ls="--", lw=1.0, label="lane margin ±%.3f m" % m if sgn > 0 else None)
+    else:                               # the margin would squash the histogram: say where it is
+        sd = stats.offtracking_sd_m
+        far = (m - abs(stats.offtracking_mean_m)) / sd if sd > 0 else float("inf")
+        ax.plot([], [], " ", label=f"lane margin ±{m:.3f} m: off the axis, {far:.3g} SD from the mean")
     ax.set_xlabel("trimmed offtracking [m]")
     ax.set_ylabel("probability density [1/m]")
     ax.grid(True, lw=0.3)
