@@ -41,6 +41,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``vehicles``         the presets built from the tables, as vehicle files
     ``configurations``   per-tire residual forces (Figures 3-6..3-8, 4-9..4-11)
     ``studies``          the chapter III-V runs, in both readings
+    ``tracking_questions`` chapter VI's open questions on straight-line tracking, answered on AU-NCAT
     ``audit``            every published number against its recomputation
 ``fmu/``                 **the FMUs**:
     ``interface``        the one interface table (SPEC sections 5 and 9)

@@ -177,6 +177,10 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--no-pdf", action="store_true", help="HTML only")
     rep.add_argument("--paper", default="letter", choices=("letter", "a4"), help="paper of the PDF (default letter)")
     rep.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
+    rep.add_argument("--tracking-stats", metavar="SPEC",
+                     help="a tire population for the straight-line tracking chapter: conicity=DIST,ply_steer=DIST,"
+                          "mounting=out|in|random[,conicity_moment=DIST,ply_steer_moment=DIST,draws=N,seed=S,"
+                          "lane_width_m=W,body_width_m=B], DIST = normal:MEAN:SD | uniform:LO:HI [N, N*m]")
     trk = sub.add_parser("tracking", help="straight-line tracking: per-tire conicity and ply steer (SPEC 13)")
     tsub = trk.add_subparsers(dest="tracking_command", metavar="WHAT", parser_class=_Parser)
     tsub.required = True
@@ -656,6 +660,20 @@ def _cmd_report(args, out: _Out) -> int:
             load_criteria(args.criteria)
         except CriteriaError as exc:
             raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
+    tracking = {"tires": None, "stats": None}
+    if args.tires:
+        from .analysis.tracking import read_mounted_tires
+        tracking["tires"] = read_mounted_tires(args.tires)      # checked by _sources above
+        if not v.steered_axles:
+            raise UsageError(f"argument --tires: {v.name} has no steered axle: the trim needs one")
+    if args.tracking_stats is not None:
+        from .analysis.tracking import TrackingError, parse_stats_spec
+        if not v.steered_axles:
+            raise UsageError(f"argument --tracking-stats: {v.name} has no steered axle: the trim needs one")
+        try:
+            tracking["stats"] = parse_stats_spec(args.tracking_stats)
+        except TrackingError as exc:
+            raise UsageError(f"argument --tracking-stats: {exc}") from None
     text = None
     if args.vehicle is not None:               # the user's file as written, comments and all
         from .model.vehicle_file import read_vehicle_text
@@ -665,7 +683,8 @@ def _cmd_report(args, out: _Out) -> int:
         res = build_assessment(v, args.out, speed_mps=speed, load_units=units, pdf=not args.no_pdf,
                                progress=lambda text: print(f"lcv report: {text}", file=sys.stderr, flush=True),
                                source=args.vehicle or f"preset {args.preset}", vehicle_text=text, paper=args.paper,
-                               residuals=residuals, criteria_file=args.criteria)
+                               residuals=residuals, criteria_file=args.criteria,
+                               tracking=tracking if tracking["tires"] or tracking["stats"] else None)
     except OutputFolderError as exc:
         raise UsageError(f"argument {exc}") from None
     except ReportError as exc:

@@ -22,7 +22,8 @@ LAYERS = ["units", "ranges", "util", "model", "analysis", "thesis", "fmu", "repo
 LAZY_UPWARD = {
     ("analysis.measures", "report.plotting"), ("analysis.response", "report.plotting"),
     ("analysis.exact", "report.plotting"), ("analysis.tracking", "report.plotting"),
-    ("thesis.studies", "report.plotting"), ("model.presets", "thesis.vehicles"),
+    ("thesis.studies", "report.plotting"), ("thesis.tracking_questions", "report.plotting"),
+    ("model.presets", "thesis.vehicles"),
 }
 
 
@@ -135,7 +136,8 @@ print(",".join(heavy))
 @pytest.mark.parametrize("package, names", [
     ("lcvreport.fmu_src", ["LCV.py", "c/fmi2_api.c", "c/model.c", "c/linalg.c", "c/loader.c", "c/model_stub.c"]),
     ("lcvreport.notebooks", [f"{s}.ipynb" for s in ("ch1_2_concepts", "ch3_tractor_semitrailer", "ch4_triple",
-                                                    "ch5_parametric", "appendices", "audit", "assessment")]),
+                                                    "ch5_parametric", "ch6_tracking", "appendices", "audit",
+                                                    "assessment")]),
     ("lcvreport.data", ["vehicles/aucnat.toml", "thesis/published.toml"]),
 ])
 def test_build_inputs_are_package_data(package, names):

@@ -200,13 +200,15 @@ def positions_of(vehicle: Vehicle, positions: list[str] | None) -> list[TireSlot
 
 @contextlib.contextmanager
 def _quiet_stdout():
-    """HiGHS writes some messages straight to file descriptor 1 even with ``disp=False``:
-    send them to the null device while it runs (standard output stays the caller's)."""
+    """HiGHS writes some messages straight to file descriptor 1 (C++ ``std::cout``) even with
+    ``disp=False``: send them to the null device while it runs.  Descriptor 1 itself, not
+    ``sys.stdout.fileno()``: a Jupyter kernel's ``sys.stdout`` reports a copy of the original
+    descriptor while descriptor 1 feeds the notebook."""
+    fd = 1
     try:
-        fd = sys.stdout.fileno()
+        sys.stdout.flush()
     except (AttributeError, OSError, ValueError):
-        fd = 1
-    sys.stdout.flush()
+        pass
     saved = os.dup(fd)
     try:
         with open(os.devnull, "w") as null:

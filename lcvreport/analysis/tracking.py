@@ -251,6 +251,11 @@ def read_mounted_tires(path) -> list[dict]:
                                                           f"missing {missing[0]!r}") +
                                 f"; columns: {', '.join(TIRE_COLUMNS + TIRE_OPTIONAL)}")
         tire = {"position": str(row["position"]).strip(), "serial_side": str(row["serial_side"]).strip()}
+        if row.get("id") not in (None, ""):
+            tire["id"] = str(row["id"]).strip()
+            if not tire["id"].isprintable() or any(t.get("id") == tire["id"] for t in out):
+                raise TrackingError(f"{path}: tire {k}: id {tire['id']!r} is " +
+                                    ("listed twice" if tire["id"].isprintable() else "not printable text"))
         if tire["serial_side"] not in ("out", "in"):
             raise TrackingError(f"{path}: tire {k}: serial_side must be out or in, got {tire['serial_side']!r}")
         for key in ("conicity_N", "ply_steer_N", "conicity_moment_Nm", "ply_steer_moment_Nm"):

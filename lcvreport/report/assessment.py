@@ -342,9 +342,11 @@ class Assessment:
         rows = [{"position": t["position"], "tire": t.get("id", ""), "serial_side": t["serial_side"],
                  "conicity_N": t.get("conicity_N", 0.0), "ply_steer_N": t.get("ply_steer_N", 0.0),
                  "conicity_moment_Nm": t.get("conicity_moment_Nm", 0.0),
-                 "ply_steer_moment_Nm": t.get("ply_steer_moment_Nm", 0.0)} for t in tires]
-        rows += [{"position": f"axle {a} (sum)", "tire": "", "serial_side": "", "conicity_N": "",
-                  "ply_steer_N": "", "P_N": loads.P_N[a], "T_Nm": loads.T_Nm.get(a, 0.0)} for a in loads.P_N]
+                 "ply_steer_moment_Nm": t.get("ply_steer_moment_Nm", 0.0), "axle_P_N": "", "axle_T_Nm": ""}
+                for t in tires]
+        rows += [{"position": f"axle {a}", "tire": "", "serial_side": "", "conicity_N": "", "ply_steer_N": "",
+                  "conicity_moment_Nm": "", "ply_steer_moment_Nm": "", "axle_P_N": loads.P_N[a],
+                  "axle_T_Nm": loads.T_Nm.get(a, 0.0)} for a in loads.P_N]
         return rows
 
     @cached_property

@@ -127,6 +127,27 @@ def _residuals(name, value, ctx):
         raise ReportError(f"parameter {name}: {exc.args[0] if exc.args else exc}") from None
 
 
+def _tracking(name, value, ctx):
+    if value is None:
+        return
+    if not isinstance(value, dict) or set(value) - {"tires", "stats"}:
+        raise ReportError(f"parameter {name} must be None or a dict with keys tires, stats, got {value!r}")
+    from ..analysis.tracking import TrackingError, axle_residuals, check_stats_spec
+    try:
+        if value.get("tires") is not None:
+            if not isinstance(value["tires"], list) or not value["tires"] or \
+                    not all(isinstance(t, dict) for t in value["tires"]):
+                raise TrackingError("tires must be a non-empty list of mounted tires (dicts)")
+            axle_residuals(ctx["vehicle"], value["tires"])
+            ids = [t.get("id") for t in value["tires"] if t.get("id")]
+            if len(set(ids)) != len(ids):
+                raise TrackingError("tire ids must be distinct")
+        if value.get("stats") is not None:
+            check_stats_spec(value["stats"])
+    except (TrackingError, KeyError, TypeError, ValueError) as exc:
+        raise ReportError(f"parameter {name}: {exc.args[0] if exc.args else exc}") from None
+
+
 def _text_or_none(name, value, _ctx):
     if value is not None and not isinstance(value, str):
         raise ReportError(f"parameter {name} must be text or None, got {value!r}")
@@ -158,6 +179,8 @@ NOTEBOOKS = (
                  {**_COMMON, "preset": _preset(TRIPLES), "speed_mph": _speed(1 / MPS_PER_MPH, "mph"),
                   "load_units": _load_units, "convention": _convention, "t_end": _t_end}),
     NotebookSpec("ch5_parametric", "ch5", "Chapter V: parametric study", {**_COMMON, "t_end": _t_end}),
+    NotebookSpec("ch6_tracking", "ch6", "Chapter VI, beyond the thesis: its open questions on straight-line tracking",
+                 dict(_COMMON)),
     NotebookSpec("appendices", "app", "Appendices B-E: dimensions, masses, tires, the 12-DOF matrices",
                  {**_COMMON, "preset": _preset(PRESETS), "speed_mph": _speed(1 / MPS_PER_MPH, "mph")}),
     NotebookSpec("audit", "audit", "Audit of the published numbers", {**_COMMON, "t_end": _t_end}),
@@ -166,6 +189,7 @@ NOTEBOOKS = (
 ASSESSMENT = NotebookSpec("assessment", "assessment", "Yaw-plane assessment",
                           {**_COMMON, "preset": lambda n, v, c: None, "vehicle_file": _vehicle_file,
                            "source": _text_or_none, "residuals": _residuals, "criteria_file": _text_or_none,
+                           "tracking": _tracking,
                            "speed_kph": _speed(1 / MPS_PER_KPH, "km/h"), "load_units": _load_units})
 SPECS = {s.stem: s for s in NOTEBOOKS + (ASSESSMENT,)}
 
@@ -513,7 +537,8 @@ def _folder_state(out: Path) -> tuple:
 def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = None, load_units=None,
                      pdf: bool = True, progress: Callable[[str], None] | None = None, fast: bool = False,
                      source: str = "", vehicle_text: str | None = None, paper: str = "letter",
-                     residuals: dict | None = None, criteria_file: str | None = None) -> dict:
+                     residuals: dict | None = None, criteria_file: str | None = None,
+                     tracking: dict | None = None) -> dict:
     """The assessment report of ``vehicle`` (SPEC section 10) into ``out_dir``.
 
     The report is written into a hidden folder beside ``out_dir`` and moved into place
@@ -548,6 +573,10 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         axle), ``crossfall_percent``.
     criteria_file : str, optional
         Limits to judge the measures by (a verdict table).
+    tracking : dict, optional
+        Straight-line tracking (SPEC 13): ``tires`` (mounted tires, as
+        :func:`lcvreport.analysis.tracking.read_mounted_tires` returns them) and/or ``stats``
+        (a tire population, :func:`lcvreport.analysis.tracking.parse_stats_spec`).
 
     Returns
     -------
@@ -577,7 +606,7 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         params = {"fast": bool(fast), "data_dir": str(data_dir), "preset": None, "vehicle_file": str(vehicle_file),
                   "source": source or None, "speed_kph": float(speed_kph), "residuals": residuals,
                   "criteria_file": None if criteria_file is None else str(Path(criteria_file).resolve()),
-                  "load_units": list(load_units) if load_units else None}
+                  "load_units": list(load_units) if load_units else None, "tracking": tracking}
         t0 = time.perf_counter()
         nb_dir = staged / "notebooks"
         nb_dir.mkdir()

@@ -656,6 +656,53 @@ def fig_offtracking_histogram(stats, title: str) -> Figure:
     return fig
 
 
+def fig_tracking_sensitivity(answer) -> Figure:
+    """Trimmed offtracking SD [m] and lane exceedance against the population's scale factor
+    (:class:`lcvreport.thesis.tracking_questions.SensitivityAnswer`)."""
+    rows = answer.rows()
+    k = np.array([r["scale"] for r in rows])
+    fig, (ax1, ax2) = new_figure(PAGE_WIDTH_IN, 3.0, ncols=2)
+    ax1.plot(k, [r["offtracking_sd_m"] for r in rows], "o-", color=PALETTE[0], label="standard deviation (exact)")
+    ax1.plot(k, [abs(r["offtracking_mean_m"]) for r in rows], "s--", color=PALETTE[1], label="|mean| (exact)")
+    ax1.set_xlabel("scale on the assumed population [-]")
+    ax1.set_ylabel("trimmed offtracking [m]")
+    ax1.grid(True, lw=0.3)
+    ax1.legend(fontsize=SMALL_PT)
+    p = np.array([r["p_exceed"] for r in rows])
+    hi = np.array([r["p_exceed_ci95_hi"] for r in rows])
+    ax2.plot(k, [r["log10_p_exceed_gaussian"] for r in rows], "o-", color=PALETTE[0], label="closed form (normal)")
+    ax2.plot(k, np.where(p > 0, np.log10(np.where(p > 0, p, 1.0)), np.nan), "s", color=PALETTE[1],
+             label="Monte Carlo estimate")
+    ax2.plot(k, np.log10(hi), "v:", color=PALETTE[2], label="Monte Carlo: upper end of its 95 % interval")
+    ax2.set_xlabel("scale on the assumed population [-]")
+    ax2.set_ylabel("log10 P(|offtracking| > lane margin) [-]")
+    ax2.grid(True, lw=0.3)
+    ax2.legend(fontsize=SMALL_PT)
+    fig.suptitle("aucnat at 50 mph: the assumed tire population scaled", fontsize=9)
+    fig.lcv_data = rows
+    return fig
+
+
+def fig_mounting_study(answer) -> Figure:
+    """|Trimmed offtracking| [m] of drawn tire sets mounted at random, in order with every
+    serial side out, and by the exact plan (:class:`lcvreport.thesis.tracking_questions.MountingAnswer`)."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, 2.8)
+    groups = (("at random", answer.random_offtracking_m), ("serial side out", answer.out_offtracking_m),
+              ("exact plan", answer.planned_offtracking_m))
+    for i, (label, x) in enumerate(groups):
+        y = np.full(x.size, i) + np.linspace(-0.2, 0.2, x.size)
+        ax.plot(np.abs(x) * 1e3, y, "o", ms=3, color=PALETTE[i], label=label)
+    ax.set_yticks(range(len(groups)), [g[0] for g in groups])
+    ax.set_xlabel("|trimmed offtracking| [mm]")
+    ax.grid(True, lw=0.3)
+    ax.set_title(f"aucnat at 50 mph: {answer.random_offtracking_m.size} tire sets drawn from the assumed population",
+                 fontsize=9)
+    fig.lcv_data = [{"set": k, "random_mounting_m": float(a), "serial_side_out_m": float(b), "plan_m": float(c)}
+                    for k, (a, b, c) in enumerate(zip(answer.random_offtracking_m, answer.out_offtracking_m,
+                                                      answer.planned_offtracking_m))]
+    return fig
+
+
 def fig_bars(labels: list[str], groups: list[tuple[str, np.ndarray]], ylabel: str, title: str,
              height: float = 3.6, horizontal: bool = False) -> Figure:
     """Grouped bar chart (Figures 5-4, 5-8, 5-13, 5-18, 5-20; conicity sensitivity).
