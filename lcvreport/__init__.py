@@ -18,6 +18,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``presets``          the six thesis vehicles, shipped as vehicle files
     ``builder``          M, S and the input matrices of any chain (SI or thesis units)
     ``loads``            residual loads P, T; the 1 % rule; load conventions
+    ``low_speed``        the second model: low-speed plane kinematics (pull points, heading law; scipy)
     ``plausibility``     warnings for legal but implausible numbers (unit typos)
 ``analysis/``            **linear analysis** (numpy, scipy):
     ``modes``            eigenvalues, damping, mode shapes
@@ -26,6 +27,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``manoeuvres``       steer inputs as continuous functions (step, sine, pulse, table, lane change)
     ``exact``            exact response to them (augmented exponential), extrema between samples
     ``field_measures``   RA peak, yaw damping (PBS style), HSTO, HSSO (SPEC 12)
+    ``low_speed_turn``   the low-speed 90° turn: swept width, offtracking, tail and frontal swing (SPEC 16)
     ``criteria``         the user's limits and the verdicts
     ``tracking``         per-tire conicity and ply steer, fleet statistics of the trimmed offtracking
     ``placement``        which measured tire goes where: the exact mounting plan (a mixed-integer program)

@@ -31,6 +31,7 @@ import math
 import os
 import sys
 import time
+from pathlib import Path
 from typing import Sequence
 
 import numpy as np
@@ -221,6 +222,16 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--draws", type=int, default=10_000, metavar="N", help="random placements to compare (1e4)")
     pl.add_argument("--seed", type=int, default=20110801, metavar="S", help="seed of the random placements")
     pl.add_argument("--json", action="store_true", help="machine-readable output")
+    turn = sub.add_parser("turn", help="low-speed 90 degree turn: swept width, offtracking, tail and frontal swing "
+                                       "(kinematic model, SPEC 16)")
+    source(turn, masses=False)
+    turn.add_argument("--radius", type=_ranged("turn_radius", what="outside steer wheel radius in m"), default=12.5,
+                      metavar="R", help=f"radius of the outside steer wheel's path [m], in "
+                                        f"{RANGES['turn_radius'].text()}; default 12.5")
+    turn.add_argument("--angle-deg", type=_ranged("turn_angle", what="turn angle in deg"), default=90.0, metavar="A",
+                      help=f"angle of the turn [deg], in {RANGES['turn_angle'].text()}; default 90")
+    turn.add_argument("--plot", metavar="FILE", help="draw the swept path into FILE (.png, .pdf or .svg; a new file)")
+    turn.add_argument("--json", action="store_true", help="machine-readable output")
     sub.add_parser("presets", help="list the presets").add_argument("--json", action="store_true")
     return p
 
@@ -779,9 +790,61 @@ def _cmd_tracking(args, out: _Out) -> int:
     return 0
 
 
+def _cmd_turn(args, out: _Out) -> int:
+    from .analysis.low_speed_turn import TurnError, low_speed_turn
+    v = _vehicle(args)
+    plot = None
+    if args.plot is not None:
+        plot = Path(args.plot)
+        if plot.suffix.lower() not in (".png", ".pdf", ".svg"):
+            raise UsageError(f"argument --plot: {plot} must end in .png, .pdf or .svg")
+        if plot.exists() or plot.is_symlink():
+            raise UsageError(f"argument --plot: {plot} exists; name a new file (lcv never overwrites one)")
+        if not plot.parent.is_dir():
+            raise UsageError(f"argument --plot: the folder {plot.parent} does not exist")
+    try:
+        t = low_speed_turn(v, args.radius, args.angle_deg)
+    except TurnError as exc:
+        raise UsageError(f"argument --{'vehicle' if args.vehicle else 'preset'}: {exc}") from None
+    if plot is not None:
+        _write_figure_new(t.plot(), plot)
+    if args.json:
+        out.json(t.to_dict())
+        return 0
+    out.line(f"{v.name}: low-speed {t.angle_deg:g} deg turn, outside steer wheel on R = {t.radius_m:g} m "
+             f"(steered axle centre on {t.steer_axle_radius_m:.3f} m); overall length {t.overall_length_m:.2f} m")
+    out.line(f"  swept width (lssp)        {t.lssp_m:8.3f} m")
+    out.line(f"  low-speed offtracking     {t.low_speed_offtracking_m:8.3f} m")
+    out.line(f"  frontal swing             {t.frontal_swing_m:8.3f} m")
+    for name, val in t.tail_swing_m.items():
+        out.line(f"  tail swing, {name:<13} {val:8.3f} m")
+    if plot is not None:
+        out.line(f"wrote {plot}")
+    return 0
+
+
+def _write_figure_new(fig, path: Path) -> None:
+    """Save a figure to a new file: written aside, then linked into place (never over a file)."""
+    import os
+    import tempfile
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=150)
+        try:
+            os.link(tmp, path)
+        except FileExistsError:
+            raise UsageError(f"argument --plot: {path} appeared while it was drawn; nothing was overwritten") \
+                from None
+        except OSError as exc:
+            raise OutputError(f"cannot write {path}: {exc.strerror}") from None
+    finally:
+        os.unlink(tmp)
+
+
 COMMANDS = {"presets": _cmd_presets, "eig": _cmd_eig, "matrices": _cmd_matrices, "steady": _cmd_steady,
             "simulate": _cmd_simulate, "measures": _cmd_measures, "fmu": _cmd_fmu, "report": _cmd_report,
-            "tracking": _cmd_tracking}
+            "tracking": _cmd_tracking, "turn": _cmd_turn}
 
 
 def run(argv: Sequence[str] | None = None, out=None) -> int:

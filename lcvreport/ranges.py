@@ -153,6 +153,9 @@ RANGES: dict[str, Range] = dict([
     ("misalignment", Range("misalignment", "rad", -0.05, 0.05,
                            description="axle misalignment (thrust angle), nose-right positive (2.9 deg)")),
     ("crossfall", Range("crossfall", "%", -20.0, 20.0, description="road crossfall, positive falling toward +y")),
+    ("turn_radius", Range("turn radius", "m", 2.0, 100.0,
+                          description="radius of the outside steer wheel's path in the low-speed turn")),
+    ("turn_angle", Range("turn angle", "deg", 0.0, 360.0, low_open=True, description="angle of the low-speed turn")),
 ])
 
 #: vehicle-file limits (SI, per tire where the file is per tire)
@@ -169,6 +172,9 @@ VEHICLE: dict[str, Range] = {
     "longitudinal_stiffness_N": Range("longitudinal_stiffness_N", "N", 0.0, 1e7, description="C_S per tire"),
     "dual_spacing_m": Range("dual_spacing_m", "m", 0.0, 2.0, description="D of a dual set"),
     "static_load_N": Range("static_load_N", "N", 0.0, 1e7, description="static vertical axle load"),
+    "body_width_m": Range("body_width_m", "m", 0.0, 5.0, low_open=True, description="width of a unit's body"),
+    "track_width_m": Range("track_width_m", "m", 0.0, 4.0, low_open=True,
+                           description="centre of the outermost tire to centre of the other"),
     "units": Range("units", "1", 1.0, 50.0, description="units in one vehicle (a road train has a few dozen at most)"),
 }
 

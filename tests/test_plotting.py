@@ -108,6 +108,18 @@ def test_plan_view_draws_every_axle_above_every_body_and_measures_from_the_cab_f
     assert len(tires) == sum(max(a.tires // 2, 1) * 2 for a in v.axles)
     assert min(t.get_zorder() for t in tires) > max(b.get_zorder() for b in bodies)
     assert [unit_kind(v, k) for k in range(6)] == ["tractor", "trailer", "dolly", "trailer", "dolly", "trailer"]
+    # the bodies of the vehicle file (issue 19): the overall length is theirs
+    from lcvreport.analysis.low_speed_turn import overall_length_m
+    front_x = max(p.get_xy()[:, 0].max() for p in bodies)
+    rear_x = min(p.get_xy()[:, 0].min() for p in bodies)
+    assert front_x - rear_x == pytest.approx(overall_length_m(v), rel=1e-12)
+    assert f"overall {overall_length_m(v):.2f} m (bodies from the vehicle file)" in ax.get_title()
+    # without body keys: guessed, from the cab front
+    from dataclasses import replace
+    bare = replace(v, units=tuple(replace(u, body_front_m=None, body_rear_m=None, body_width_m=None)
+                                  for u in v.units))
+    ax = fig_vehicle(bare, "aucnat").axes[0]
+    bodies = [p for p in ax.patches if isinstance(p, Polygon) and p.get_facecolor()[:3] != (0.0, 0.0, 0.0)]
     steer_x = max(a.x_m for a in v.units[0].axles)
     rear_x = min(p.get_xy()[:, 0].min() for p in bodies)
     expected = steer_x + FRONT_OVERHANG_M - rear_x

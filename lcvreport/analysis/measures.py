@@ -27,9 +27,11 @@ Examples
 >>> from lcvreport.units import kph_to_mps
 >>> m = measure_set(load_preset("aucnat"), kph_to_mps(88.0), load_units=["trailer2", "trailer3"])
 >>> sorted(m.to_dict())[:6]
-['ay_gain_per_unit', 'critical_speed_kph', 'hsso_m', 'hsto_m', 'least_damped_frequency_hz', 'least_damping_ratio']
+['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m', 'hsto_m', 'least_damped_frequency_hz']
 """
 from __future__ import annotations
+
+import functools
 
 import math
 from dataclasses import dataclass, field
@@ -393,6 +395,10 @@ class MeasureSet:
     hsso_m: float | None = None
     steady_turn_delta_rad: float | None = None
     sources: object = None
+    lssp_m: float | None = None
+    low_speed_offtracking_m: float | None = None
+    max_tail_swing_m: float | None = None
+    frontal_swing_m: float | None = None
 
     def to_dict(self) -> dict:
         """The SPEC section 8 JSON document."""
@@ -401,7 +407,7 @@ class MeasureSet:
                "critical_speed_kph": self.critical_speed_kph, "ra_frequency": self.ra_frequency,
                "ra_single_sine": self.ra_single_sine,
                "ay_gain_per_unit": None if self.ay_gain_per_unit is None else list(self.ay_gain_per_unit)}
-        for key in FIELD_KEYS:
+        for key in FIELD_KEYS + LOW_SPEED_KEYS:
             doc[key] = getattr(self, key)
         if self.trim is not None:
             doc["trim"] = {"delta_rad": self.trim.delta_rad, "offtracking_m": self.trim.offtracking_m}
@@ -435,7 +441,7 @@ class MeasureSet:
         for k, (name, g) in enumerate(zip(self.vehicle.unit_names, self.ay_gain_per_unit or ())):
             rows.append({"measure": f"lateral acceleration gain, {name}", "value": g, "unit": "m/s²/rad",
                          "note": f"|G_{k + 1}(j2π·{f})|", "json_key": f"ay_gain_per_unit[{k}]"})
-        for key, (label, unit, note) in FIELD_ROWS.items():
+        for key, (label, unit, note) in {**FIELD_ROWS, **LOW_SPEED_ROWS}.items():
             value = getattr(self, key)
             rows.append({"measure": label, "value": num(value), "unit": unit,
                          "note": self.undefined.get(key, note), "json_key": key})
@@ -467,6 +473,29 @@ FIELD_ROWS = {
 }
 
 
+#: the SPEC section 16 keys (the low-speed 90 degree turn, outside steer wheel on 12.5 m; any speed)
+LOW_SPEED_KEYS = ("lssp_m", "low_speed_offtracking_m", "max_tail_swing_m", "frontal_swing_m")
+LOW_SPEED_ROWS = {
+    "lssp_m": ("low-speed swept path (swept width)", "m", "90° turn, outside steer wheel on R 12.5 m"),
+    "low_speed_offtracking_m": ("low-speed offtracking", "m", "steered axle path radius − last rear axle radius"),
+    "max_tail_swing_m": ("tail swing, largest", "m", "rear outer corner beyond its approach line"),
+    "frontal_swing_m": ("frontal swing", "m", "front outer corner outside the outside steer wheel's path"),
+}
+
+
+@functools.lru_cache(maxsize=64)
+def low_speed_measures(vehicle: Vehicle) -> tuple[dict, str | None]:
+    """The SPEC section 16 measures of ``vehicle`` (independent of speed and tire scale:
+    cached per vehicle), or ``({}, why)`` when the file lacks the geometry."""
+    from .low_speed_turn import TurnError, low_speed_turn
+    try:
+        t = low_speed_turn(vehicle)
+    except TurnError as exc:
+        return {}, f"undefined: {exc}"
+    return {"lssp_m": t.lssp_m, "low_speed_offtracking_m": t.low_speed_offtracking_m,
+            "max_tail_swing_m": t.max_tail_swing_m, "frontal_swing_m": t.frontal_swing_m}, None
+
+
 def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, load_units=None,
                 f_hz: float = RA_FREQUENCY_HZ, sources=None) -> MeasureSet:
     """Every SPEC section 8 and 12 measure of ``vehicle`` at ``speed_mps`` [m/s].
@@ -489,21 +518,23 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     >>> from lcvreport import load_preset
     >>> m = measure_set(load_preset("tractor_semitrailer"), 24.4444)
     >>> sorted(m.to_dict())[:4]
-    ['ay_gain_per_unit', 'critical_speed_kph', 'hsso_m', 'hsto_m']
+    ['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m']
     """
     from . import field_measures as fm
     from .exact import ManoeuvreError
     zeta, f_zeta = least_damping(vehicle, speed_mps, tire_scale)
     units = tuple(load_units) if load_units else ()
     has_sources = bool(units) or bool(sources)
+    low, low_why = low_speed_measures(vehicle)
     if not vehicle.steered_axles:
         why = "undefined: the vehicle has no steered axle, so no steer input to respond to or trim with"
         undefined = {k: why for k in ("ra_frequency", "ra_single_sine", "ay_gain_per_unit") + FIELD_KEYS}
+        undefined.update({k: low_why for k in LOW_SPEED_KEYS if low_why})
         if has_sources:
             undefined["trim"] = why
         return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
                           critical_speed(vehicle, tire_scale), None, None, None, None, units, float(f_hz), undefined,
-                          sources=sources)
+                          sources=sources, **low)
     gains = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
     ss = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale)
     tr = None
@@ -515,7 +546,7 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
             F = F + sources.vector(vehicle, tire_scale)
         tr = trim(vehicle, speed_mps, F, tire_scale)
         check_trim(tr)
-    undefined = {}
+    undefined = {k: low_why for k in LOW_SPEED_KEYS if low_why}
     peak = fm.ra_peak(vehicle, speed_mps, tire_scale)
     ydc = fm.yaw_damping_coefficient(vehicle, speed_mps, tire_scale)
     if ydc.value is None:
@@ -530,7 +561,7 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
                       critical_speed(vehicle, tire_scale), float(gains[-1] / gains[0]), ss.rearward_amplification,
                       [float(g) for g in gains], tr, units, float(f_hz), undefined, peak.value, peak.frequency_hz,
-                      ydc.value, hsto, ra_lc, turn.hsso_m, turn.delta_rad, sources)
+                      ydc.value, hsto, ra_lc, turn.hsso_m, turn.delta_rad, sources, **low)
 
 
 def check_trim(tr: Trim) -> None:

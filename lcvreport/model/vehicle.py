@@ -138,6 +138,9 @@ class Axle:
         The steer angle delta acts on this axle (first unit only).
     static_load_N : float or None
         Static vertical load [N]; needed only by the 1 % rule.
+    track_width_m : float or None
+        Lateral distance between the centres of the outermost tires [m]; needed only by
+        the low-speed turn (SPEC section 16).
     """
 
     name: str
@@ -149,6 +152,7 @@ class Axle:
     dual_spacing_m: float
     steered: bool = False
     static_load_N: float | None = None
+    track_width_m: float | None = None
 
     def __post_init__(self):
         _name("name", self.name, AXLE_NAME, "a name of letters, digits and _")
@@ -164,6 +168,8 @@ class Axle:
             raise VehicleError("steered", f"steered must be true or false, got {self.steered!r}")
         if self.static_load_N is not None:
             set_("static_load_N", _number("static_load_N", self.static_load_N, "static_load_N"))
+        if self.track_width_m is not None:
+            set_("track_width_m", _number("track_width_m", self.track_width_m, "track_width_m"))
 
     # per-axle sums (tires x per-tire coefficient)
     @property
@@ -203,6 +209,11 @@ class Unit:
     rear_end_m : float or None
         Signed x of the point whose lateral offset is reported as y_k [m]; None for
         the default (the rear coupling, or the rearmost axle on the last unit).
+    body_front_m, body_rear_m : float or None
+        Signed x of the body's front and rear faces [m] (given together, rear < front);
+        needed only by the low-speed turn and the drawings (SPEC section 16).
+    body_width_m : float or None
+        Width of the body [m], symmetric about the unit's axis.
     """
 
     name: str
@@ -212,15 +223,27 @@ class Unit:
     front_coupling_m: float | None = None
     rear_coupling_m: float | None = None
     rear_end_m: float | None = None
+    body_front_m: float | None = None
+    body_rear_m: float | None = None
+    body_width_m: float | None = None
 
     def __post_init__(self):
         _name("name", self.name, UNIT_NAME, "a name of letters, digits, _ . - (no commas or spaces)")
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
         set_("mass_kg", _number("mass_kg", self.mass_kg, "mass_kg"))
         set_("yaw_inertia_kg_m2", _number("yaw_inertia_kg_m2", self.yaw_inertia_kg_m2, "yaw_inertia_kg_m2"))
-        for key in ("front_coupling_m", "rear_coupling_m", "rear_end_m"):
+        for key in ("front_coupling_m", "rear_coupling_m", "rear_end_m", "body_front_m", "body_rear_m"):
             if getattr(self, key) is not None:
                 set_(key, _number(key, getattr(self, key), "position_m"))
+        if self.body_width_m is not None:
+            set_("body_width_m", _number("body_width_m", self.body_width_m, "body_width_m"))
+        if (self.body_front_m is None) != (self.body_rear_m is None):
+            given, missing = ("body_front_m", "body_rear_m") if self.body_rear_m is None else \
+                ("body_rear_m", "body_front_m")
+            raise VehicleError(missing, f"{missing} is needed with {given}: a body has a front and a rear face")
+        if self.body_front_m is not None and self.body_rear_m >= self.body_front_m:
+            raise VehicleError("body_rear_m", f"body_rear_m must be behind body_front_m ({self.body_front_m:g} m), "
+                                              f"got {self.body_rear_m:g} m")
         axles = tuple(self.axles) if isinstance(self.axles, (list, tuple)) else self.axles
         if not isinstance(axles, tuple) or not all(isinstance(a, Axle) for a in axles):
             raise VehicleError("axles", f"axles must be a list of Axle, got {self.axles!r}")

@@ -12,6 +12,9 @@
     yaw_inertia_kg_m2 = 35000.0      # > 0, about the CG
     rear_coupling_m = -0.30          # every unit but the last; absent on the last
     rear_end_m = -2.0                # optional: point whose lateral offset is y_k
+    body_front_m = 3.0               # optional (with body_rear_m): x of the body's front face
+    body_rear_m = -3.2               # optional: x of its rear face, behind the front
+    body_width_m = 2.55              # optional: body width; the three are for the low-speed turn
 
       [[units.axles]]
       name = "steer"                 # unique in the vehicle, [A-Za-z0-9_]+
@@ -23,6 +26,7 @@
       longitudinal_stiffness_N = 0.0            # >= 0 (with dual_spacing_m)
       dual_spacing_m = 0.0                      # >= 0
       static_load_N = 53000.0                   # optional; needed by the 1 % rule
+      track_width_m = 2.05                      # optional: outermost tire centres; the low-speed turn
 
     [[units]]
     name = "trailer1"
@@ -77,9 +81,9 @@ MAX_DEPTH = 16
 #: keys of the top level, a unit and an axle: (required, optional)
 TOP_KEYS = (("format", "name", "units"), ("description",))
 UNIT_KEYS = (("name", "mass_kg", "yaw_inertia_kg_m2", "axles"),
-             ("front_coupling_m", "rear_coupling_m", "rear_end_m"))
+             ("front_coupling_m", "rear_coupling_m", "rear_end_m", "body_front_m", "body_rear_m", "body_width_m"))
 AXLE_KEYS = (("name", "x_m", "tires", "cornering_stiffness_N_per_rad", "aligning_stiffness_Nm_per_rad",
-              "longitudinal_stiffness_N", "dual_spacing_m"), ("steered", "static_load_N"))
+              "longitudinal_stiffness_N", "dual_spacing_m"), ("steered", "static_load_N", "track_width_m"))
 
 
 class VehicleFileError(VehicleError):
@@ -293,7 +297,8 @@ def dumps_vehicle(vehicle: Vehicle, header: str = "", unit_comments: dict | None
         out += [f"# {line}".rstrip() for line in unit_comments.get(u.name, "").splitlines()]
         out.append("[[units]]")
         out.append(f"name = {_value(u.name)}")
-        for key in ("mass_kg", "yaw_inertia_kg_m2", "front_coupling_m", "rear_coupling_m", "rear_end_m"):
+        for key in ("mass_kg", "yaw_inertia_kg_m2", "front_coupling_m", "rear_coupling_m", "rear_end_m",
+                    "body_front_m", "body_rear_m", "body_width_m"):
             if getattr(u, key) is not None:
                 out.append(f"{key} = {_value(getattr(u, key))}")
         for a in u.axles:

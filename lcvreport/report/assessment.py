@@ -279,6 +279,22 @@ class Assessment:
         fig.lcv_data = self.sensitivity_rows()
         return fig
 
+    # ------------------------------------------------------------------ low-speed turn (SPEC 16)
+    @cached_property
+    def low_speed_turn(self):
+        """:class:`lcvreport.analysis.low_speed_turn.LowSpeedTurn`, or the reason it is not computed (str)."""
+        from ..analysis.low_speed_turn import TurnError, low_speed_turn
+        try:
+            return low_speed_turn(self.vehicle)
+        except TurnError as exc:
+            return str(exc)
+
+    def low_speed_rows(self) -> list[dict]:
+        return self.low_speed_turn.rows()
+
+    def fig_swept_path(self):
+        return self.low_speed_turn.plot(f"{self.vehicle.name}: low-speed 90° turn, outside steer wheel on R = 12.5 m")
+
     # ------------------------------------------------------------------ straight-line tracking (SPEC 13)
     def _tire_force(self) -> np.ndarray:
         """The generalized force of the mounted tires alone (SI)."""

@@ -11,6 +11,8 @@ they are printed at (:data:`PAGE_WIDTH_IN`).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from matplotlib import patheffects
 from matplotlib.figure import Figure
@@ -100,8 +102,12 @@ def _rect(center: np.ndarray, psi: float, front: float, rear: float, half_width:
 
 
 def body_extent(vehicle: Vehicle, k: int) -> tuple[float, float, float]:
-    """(front x, rear x, half width) of the drawn body of unit ``k`` [m, signed x from its CG]."""
+    """(front x, rear x, half width) of the drawn body of unit ``k`` [m, signed x from its CG]:
+    the vehicle file's ``body_front_m``, ``body_rear_m``, ``body_width_m`` where given, else
+    an outline guessed from the axles and couplings."""
     u = vehicle.units[k]
+    if u.body_front_m is not None and u.body_width_m is not None:
+        return u.body_front_m, u.body_rear_m, u.body_width_m / 2
     xs = [a.x_m for a in u.axles]
     kind = unit_kind(vehicle, k)
     if kind == "tractor":
@@ -201,8 +207,11 @@ def fig_vehicle(vehicle: Vehicle, title: str) -> Figure:
     draw_vehicle(ax, vehicle)
     for k, (cg, _psi) in enumerate(poses):
         ax.plot(cg[0], cg[1], "+", color="red", ms=5, mew=0.8, zorder=6)
-    ax.set_title(f"{title} (to scale; + CG, o coupling)\noverall about {length:.1f} m (cab front assumed "
-                 f"{FRONT_OVERHANG_M:.2f} m ahead of the steer axle)", fontsize=8)
+    from_file = all(u.body_front_m is not None and u.body_width_m is not None for u in vehicle.units)
+    ax.set_title(f"{title} (to scale; + CG, o coupling)\n" +
+                 (f"overall {length:.2f} m (bodies from the vehicle file)" if from_file else
+                  f"overall about {length:.1f} m (bodies guessed: the file has no body keys; cab front assumed "
+                  f"{FRONT_OVERHANG_M:.2f} m ahead of the steer axle)"), fontsize=8)
     _top_view_axes(ax, "m", ylim_m=2.6)
     return fig
 
@@ -653,6 +662,98 @@ def fig_offtracking_histogram(stats, title: str) -> Figure:
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=SMALL_PT)
     ax.set_title(f"{title}: P(|offtracking| > {m:.3f} m) = {stats.exceedance_probability:.3g}", fontsize=9)
+    return fig
+
+
+def fig_swept_path(turn, title: str, outlines_every_m: float = 2.0) -> Figure:
+    """The low-speed turn seen from above, to scale (SPEC section 16): every unit's outline
+    every ``outlines_every_m`` of path, the swept region's envelope within the turn, the
+    paths of the outside steer wheel and of the last unit's inside rear wheel, the arc's
+    centre and the measures marked [m].  ``turn`` is a
+    :class:`lcvreport.analysis.low_speed_turn.LowSpeedTurn`."""
+    from matplotlib.patches import Polygon as _Poly
+    from ..analysis.low_speed_turn import corners
+    v, run = turn.vehicle, turn.run
+    path = run.path
+    C = path.centre
+    s_draw_end = min(path.s_end, path.arc_end_s + 1.2 * turn.overall_length_m)
+    fig, ax = new_figure(PAGE_WIDTH_IN, 5.6)
+    # outlines
+    s_out = np.arange(0.0, s_draw_end + 1e-9, outlines_every_m)
+    for k in range(v.n_units):
+        cx, cy = corners(v, k)
+        pts = run.unit_points(s_out, k, cx, cy)
+        for j, poly in enumerate(pts):
+            ax.add_patch(_Poly(poly, closed=True, facecolor="none", edgecolor=PALETTE[k % len(PALETTE)],
+                               lw=0.35, alpha=0.55, zorder=1))
+    # the vehicle at the start, filled
+    for k in range(v.n_units):
+        cx, cy = corners(v, k)
+        ax.add_patch(_Poly(run.unit_points([0.0], k, cx, cy)[0], closed=True, facecolor=PALETTE[k % len(PALETTE)],
+                           edgecolor="black", lw=0.5, alpha=0.35, zorder=2,
+                           label="the combination before the turn" if k == 0 else None))
+    # envelope within the sector: extremes of corners, wheels and sides in angle bins
+    s_fine = np.linspace(0.0, s_draw_end, 1500)
+    pts = []
+    for k, u in enumerate(v.units):
+        cx, cy = corners(v, k)
+        xs = np.concatenate([cx, np.linspace(u.body_front_m, u.body_rear_m, 12), np.linspace(u.body_front_m,
+                             u.body_rear_m, 12)])
+        ys = np.concatenate([cy, np.full(12, u.body_width_m / 2), np.full(12, -u.body_width_m / 2)])
+        for a in u.axles:
+            xs = np.append(xs, [a.x_m, a.x_m])
+            ys = np.append(ys, [a.track_width_m / 2, -a.track_width_m / 2])
+        pts.append(run.unit_points(s_fine, k, xs, ys).reshape(-1, 2))
+    pts = np.concatenate(pts)
+    rel = pts - C
+    phi = np.arctan2(rel[:, 0], -rel[:, 1])
+    r = np.hypot(rel[:, 0], rel[:, 1])
+    angle = math.radians(min(turn.angle_deg, 360.0))
+    bins = np.linspace(0.0, angle, 91)
+    idx = np.digitize(phi, bins) - 1
+    ok = (idx >= 0) & (idx < 90)
+    r_max = np.full(90, np.nan)
+    r_min = np.full(90, np.nan)
+    for b in range(90):
+        sel = ok & (idx == b)
+        if sel.any():
+            r_max[b], r_min[b] = r[sel].max(), r[sel].min()
+    mid = 0.5 * (bins[1:] + bins[:-1])
+    env = lambda rr: np.stack([C[0] + rr * np.sin(mid), C[1] - rr * np.cos(mid)], axis=1)  # noqa: E731
+    ax.plot(*env(r_max).T, color="black", lw=1.4, zorder=6, label="envelope of the swept region (in the turn)")
+    ax.plot(*env(r_min).T, color="black", lw=1.4, zorder=6)
+    # the two wheel paths
+    steer = max((a for a in v.units[0].axles if a.steered), key=lambda a: a.x_m)
+    s_path = np.linspace(-0.3 * turn.overall_length_m, s_draw_end, 800)
+    s_pos = np.clip(s_path, 0.0, None)
+    ow = run.unit_points(s_pos, 0, [steer.x_m], [-steer.track_width_m / 2])[:, 0]
+    ow[s_path < 0, 0] += s_path[s_path < 0]
+    ax.plot(*ow.T, color=PALETTE[1], lw=1.2, zorder=5, label=f"outside wheel of axle {steer.name} (R = "
+            f"{turn.radius_m:g} m)")
+    last = v.n_units - 1
+    rear = v.units[last].rearmost_axle
+    iw = run.unit_points(s_pos, last, [rear.x_m], [rear.track_width_m / 2])[:, 0]
+    iw[s_path < 0, 0] += s_path[s_path < 0]
+    ax.plot(*iw.T, color=PALETTE[2], lw=1.2, zorder=5, label=f"inside wheel of axle {rear.name}")
+    ax.plot(*C, "+", color="black", ms=8, zorder=6)
+    # measures: the swept width along the bisector of the turn, the offtracking in the text
+    w = turn.where
+    b = 0.5 * angle
+    u_dir = np.array([math.sin(b), -math.cos(b)])
+    p_in, p_out = C + w["inner_radius_m"] * u_dir, C + w["outer_radius_m"] * u_dir
+    ax.annotate("", p_out, p_in, arrowprops=dict(arrowstyle="<->", lw=0.9, color="black"), zorder=7)
+    ax.text(*(0.5 * (p_in + p_out)), f"  swept width {turn.lssp_m:.2f} m", fontsize=SMALL_PT, zorder=7,
+            rotation=math.degrees(b) - 90 if -90 < math.degrees(b) - 90 < 90 else 0)
+    ax.set_aspect("equal")
+    ax.set_xlabel("X [m]")
+    ax.set_ylabel("Y [m]")
+    ax.grid(True, lw=0.3)
+    ax.autoscale_view()
+    ax.legend(fontsize=SMALL_PT, loc="upper left")
+    ax.set_title(f"{title}\nswept width {turn.lssp_m:.2f} m, low-speed offtracking "
+                 f"{turn.low_speed_offtracking_m:.2f} m, largest tail swing {turn.max_tail_swing_m:.3f} m, "
+                 f"frontal swing {turn.frontal_swing_m:.2f} m", fontsize=8)
+    fig.lcv_data = turn.rows()
     return fig
 
 

@@ -70,12 +70,27 @@ def preset_from_tables(name: str) -> Vehicle:
     D_m = g["dual_spacing"]["D_in"] * M_PER_IN
     units = []
 
+    b = g["bodies"]
+
     def axle(aname, x_in, row, n_tires, load_lbf, steered=False, dual=True):
         t = tires[row]
         return Axle(aname, x_in * M_PER_IN, n_tires, _lbf_per_rad(t["CF_lbf_per_rad"]),
                     t["CM_lbf_in_per_rad"] * THESIS.moment_Nm,
                     t.get("CS_lbf_per_rad", 0.0) * N_PER_LBF if dual else 0.0, D_m if dual else 0.0,
-                    steered=steered, static_load_N=load_lbf * N_PER_LBF)
+                    steered=steered, static_load_N=load_lbf * N_PER_LBF,
+                    track_width_m=(b["dual_track_in"] if dual else b["steer_track_in"]) * M_PER_IN)
+
+    def body(uname, axles, rear_coupling, rear_end):
+        """(front, rear, width) [m] of a unit's body from the gaps of ``gaps.toml``."""
+        xs = [a.x_m for a in axles]
+        if uname == "tractor":
+            return (max(xs) + b["tractor_front_ahead_of_steer_axle_in"] * M_PER_IN,
+                    min(xs) - b["tractor_rear_behind_rear_axle_in"] * M_PER_IN, b["body_width_in"] * M_PER_IN)
+        if uname.startswith("dolly"):
+            return (max(xs) + b["dolly_front_ahead_of_axle_in"] * M_PER_IN,
+                    min(xs) - b["dolly_rear_behind_axle_in"] * M_PER_IN, b["dolly_width_in"] * M_PER_IN)
+        rear_face = rear_coupling if rear_coupling is not None else rear_end
+        return rear_face + b["trailer_length_in"] * M_PER_IN, rear_face, b["body_width_in"] * M_PER_IN
 
     for k, uname in enumerate(UNIT_NAMES[:n_units]):
         i = k + 1
@@ -92,8 +107,10 @@ def preset_from_tables(name: str) -> Vehicle:
         else:
             axles = [axle(f"{i}1", -dims[f"x{i}1_in"], _ROW[uname], n_other, mass[_ROW[uname]]["axle_load_lbf"])]
         row = mass[_ROW[uname]]
+        bf, br, bw = body(uname, axles, rear, rear_end)
         units.append(Unit(uname, row["mass_lbf_s2_per_in"] * THESIS.mass_kg,
-                          row["inertia_lbf_in_s2"] * THESIS.inertia_kg_m2, tuple(axles), front, rear, rear_end))
+                          row["inertia_lbf_in_s2"] * THESIS.inertia_kg_m2, tuple(axles), front, rear, rear_end,
+                          body_front_m=bf, body_rear_m=br, body_width_m=bw))
     tables = f"Tables {dims['table']}, {mass['table']}, {tires['table']}"
     desc = (f"{tables} of Patterson (2011), converted to SI" +
             (" (tractor and trailer 1 of the AU-NCAT triple, chapter III)" if name == "tractor_semitrailer" else ""))
@@ -111,7 +128,11 @@ def preset_file_text(name: str) -> str:
               f"Tires per axle: {g['tires_per_axle']['source']}\n"
               f"Dual spacing D = {g['dual_spacing']['D_in']:g} in: {g['dual_spacing']['source']}\n"
               f"Tractor tandem: {g['tandem']['source']}\n"
-              "Steer axle 11: single tires, no dual term (C_S = 0, D = 0).")
+              "Steer axle 11: single tires, no dual term (C_S = 0, D = 0).\n"
+              f"Bodies (low-speed turn, drawings): trailers {g['bodies']['trailer_length_source']}; "
+              f"{g['bodies']['trailer_rear_source']}; width: {g['bodies']['body_width_source']}; tractor: "
+              f"{g['bodies']['tractor_source']}; dollies: {g['bodies']['dolly_source']}.\n"
+              f"Track widths: {g['bodies']['track_source']}.")
     dims, mass, tires = dimensions(config), mass_table(config), tire_table(config)
     unit_comments, axle_comments = {}, {}
     for k, u in enumerate(v.units):

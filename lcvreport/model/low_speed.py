@@ -1,0 +1,256 @@
+r"""Low-speed kinematics of a combination: plane motion at walking pace, no inertia (SPEC section 16).
+
+A second model beside the linear yaw-plane one: angles of any size, no speed, no mass.
+
+* **Pull points.** Unit 1 is pulled at the centre of its frontmost steered axle, which
+  follows a prescribed path; unit i >= 2 at its front coupling, which moves with unit
+  i-1's rear coupling.
+* **Heading.** With no inertia the lateral forces of a unit's axles have no moment about
+  its pull point.  With linear tires (C_j = tires x C_F of axle j, aligning and dual-tire
+  terms neglected; the steered axles of unit 1 carry no lateral force) and d_j the signed
+  x of axle j from the pull point along the unit's axis, the yaw rate per metre of path is
+
+  .. math:: \frac{d\psi_i}{ds} = -\,v_{\perp,i}\,\frac{\sum_j C_j d_j}{\sum_j C_j d_j^2}
+
+  with v_perp,i the pull point's velocity across the unit's axis per metre of path:
+  independent of speed (a single axle gives the tractrix), a tandem acting as one axle
+  at d = sum C d^2 / sum C d.
+
+The frame is a plane one, X forward at the start, Y to the left, headings counter-clockwise
+(a turn to the left has a growing heading); the measures that use it are distances.
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> import numpy as np
+>>> v = load_preset("tractor_semitrailer")
+>>> run = integrate(v, StraightArcPath(radius_m=12.0, angle_rad=np.pi / 2, exit_m=40.0), np.zeros(2))
+>>> bool(run.headings(run.s_end)[1] > 1.5)          # the trailer has followed round the corner
+True
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .vehicle import Vehicle
+
+#: integrator tolerances (relative on the headings; absolute in rad)
+RTOL = 1e-10
+ATOL = 1e-12
+
+
+class KinematicsError(ValueError):
+    """A vehicle the low-speed model cannot pull: the message names the unit and what is missing."""
+
+
+@dataclass(frozen=True)
+class UnitGeometry:
+    """What the heading law needs of one unit (x signed from its CG, forward positive) [m]."""
+
+    pull_x_m: float
+    rear_coupling_x_m: float | None
+    d_m: np.ndarray               # axle x from the pull point, the axles that carry lateral force
+    C_N_per_rad: np.ndarray       # tires x C_F of those axles
+    gain_per_m: float             # sum C d / sum C d^2 [1/m]
+
+
+def unit_geometry(vehicle: Vehicle) -> list[UnitGeometry]:
+    """Pull points and the heading law's gain of every unit.
+
+    Raises
+    ------
+    KinematicsError
+        A first unit with no steered axle or no unsteered one; a unit whose axles all sit
+        at its pull point.
+    """
+    out = []
+    for k, u in enumerate(vehicle.units):
+        if k == 0:
+            steered = [a for a in u.axles if a.steered]
+            if not steered:
+                raise KinematicsError(f'unit 1 "{u.name}": no steered axle to pull it along the path')
+            pull = max(a.x_m for a in steered)
+            axles = [a for a in u.axles if not a.steered]
+            if not axles:
+                raise KinematicsError(f'unit 1 "{u.name}": every axle is steered; the low-speed turn needs an '
+                                      "unsteered one to fix the unit's heading")
+        else:
+            pull = u.front_coupling_m
+            axles = list(u.axles)
+        d = np.array([a.x_m - pull for a in axles])
+        C = np.array([a.cornering_stiffness_axle_N_per_rad for a in axles])
+        den = float(np.sum(C * d * d))
+        if not den > 0:
+            raise KinematicsError(f'unit {k + 1} "{u.name}": every axle is at its pull point; its heading is '
+                                  "not fixed")
+        out.append(UnitGeometry(pull, u.rear_coupling_m, d, C, float(np.sum(C * d)) / den))
+    return out
+
+
+@dataclass(frozen=True)
+class StraightArcPath:
+    """The path of unit 1's pull point: a circular arc to the left from (0, 0) heading +X,
+    of ``radius_m`` through ``angle_rad``, then a straight exit of ``exit_m``.  Arc length
+    s in [0, s_end]; a straight approach (s < 0) along Y = 0 for drawing."""
+
+    radius_m: float
+    angle_rad: float
+    exit_m: float
+
+    @property
+    def arc_end_s(self) -> float:
+        return self.radius_m * self.angle_rad
+
+    @property
+    def s_end(self) -> float:
+        return self.arc_end_s + self.exit_m
+
+    @property
+    def centre(self) -> np.ndarray:
+        return np.array([0.0, self.radius_m])
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Path lengths where the curvature jumps."""
+        return (0.0, self.arc_end_s, self.s_end)
+
+    def point(self, s):
+        """(X, Y) [m] at arc length ``s`` (scalar or array)."""
+        s = np.asarray(s, dtype=float)
+        R, a = self.radius_m, self.angle_rad
+        phi = np.clip(s, 0.0, self.arc_end_s) / R
+        x = R * np.sin(phi) + np.where(s < 0, s, 0.0) + np.maximum(s - self.arc_end_s, 0.0) * math.cos(a)
+        y = R * (1 - np.cos(phi)) + np.maximum(s - self.arc_end_s, 0.0) * math.sin(a)
+        return np.stack([x, y], axis=-1)
+
+    def tangent(self, s: float) -> np.ndarray:
+        phi = min(max(s, 0.0), self.arc_end_s) / self.radius_m
+        return np.array([math.cos(phi), math.sin(phi)])
+
+
+@dataclass(frozen=True)
+class StraightPath:
+    """A straight path along +X from (0, 0) (the tractrix test)."""
+
+    length_m: float
+
+    @property
+    def s_end(self) -> float:
+        return self.length_m
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        return (0.0, self.length_m)
+
+    def point(self, s):
+        s = np.asarray(s, dtype=float)
+        return np.stack([s, np.zeros_like(s)], axis=-1)
+
+    def tangent(self, s: float) -> np.ndarray:
+        return np.array([1.0, 0.0])
+
+
+@dataclass(frozen=True)
+class KinematicRun:
+    """Headings of every unit along the path, with the pull points (callable on arrays of s)."""
+
+    vehicle: Vehicle
+    path: object
+    geometry: tuple
+    pieces: tuple                 # OdeSolution per path segment
+    s_end: float
+
+    def headings(self, s) -> np.ndarray:
+        """Headings [rad] of every unit at arc length ``s``: shape (N,) or (len(s), N)."""
+        s_arr = np.atleast_1d(np.asarray(s, dtype=float))
+        out = np.empty((s_arr.size, len(self.geometry)))
+        edges = [p[0] for p in self.pieces] + [self.s_end]
+        for k, (lo, sol) in enumerate(self.pieces):
+            hi = edges[k + 1]
+            mask = (s_arr >= lo) & ((s_arr <= hi) if k == len(self.pieces) - 1 else (s_arr < hi))
+            if mask.any():
+                out[mask] = sol(s_arr[mask]).T
+        return out[0] if np.ndim(s) == 0 else out
+
+    def pull_points(self, s) -> np.ndarray:
+        """Pull points [m] of every unit: shape (len(s), N, 2)."""
+        s_arr = np.atleast_1d(np.asarray(s, dtype=float))
+        psi = self.headings(s_arr).reshape(s_arr.size, -1)
+        P = np.empty((s_arr.size, len(self.geometry), 2))
+        P[:, 0] = self.path.point(s_arr)
+        for i in range(1, len(self.geometry)):
+            g = self.geometry[i - 1]
+            L = g.rear_coupling_x_m - g.pull_x_m
+            P[:, i, 0] = P[:, i - 1, 0] + L * np.cos(psi[:, i - 1])
+            P[:, i, 1] = P[:, i - 1, 1] + L * np.sin(psi[:, i - 1])
+        return P
+
+    def unit_points(self, s, k: int, x_m, y_m) -> np.ndarray:
+        """World (X, Y) [m] of points of unit ``k`` at unit coordinates (x from its CG,
+        forward; y to its left), at every arc length of ``s``: shape (len(s), n_points, 2)."""
+        s_arr = np.atleast_1d(np.asarray(s, dtype=float))
+        psi = self.headings(s_arr).reshape(s_arr.size, -1)[:, k]
+        P = self.pull_points(s_arr)[:, k]
+        x = np.atleast_1d(np.asarray(x_m, dtype=float)) - self.geometry[k].pull_x_m
+        y = np.atleast_1d(np.asarray(y_m, dtype=float))
+        c, sn = np.cos(psi)[:, None], np.sin(psi)[:, None]
+        return np.stack([P[:, None, 0] + c * x - sn * y, P[:, None, 1] + sn * x + c * y], axis=-1)
+
+
+def _rhs(geometry, path):
+    n = len(geometry)
+    lever = [(g.rear_coupling_x_m - g.pull_x_m) if g.rear_coupling_x_m is not None else 0.0 for g in geometry]
+
+    def f(s, psi):
+        v = path.tangent(s)
+        vx, vy = float(v[0]), float(v[1])
+        out = np.empty(n)
+        for i in range(n):
+            c, sn = math.cos(psi[i]), math.sin(psi[i])
+            v_perp = -sn * vx + c * vy
+            rate = -v_perp * geometry[i].gain_per_m
+            out[i] = rate
+            # the next unit's pull point: this one's plus the lever turning with this unit
+            vx, vy = vx - lever[i] * rate * sn, vy + lever[i] * rate * c
+        return out
+    return f
+
+
+def integrate(vehicle: Vehicle, path, psi0, rtol: float = RTOL, atol: float = ATOL) -> KinematicRun:
+    """Headings of every unit along ``path`` from the headings ``psi0`` [rad] at s = 0.
+
+    Integrated in arc length with :func:`scipy.integrate.solve_ivp` (DOP853), segment by
+    segment of the path (its curvature jumps between them).
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    path : StraightArcPath or StraightPath
+        Anything with ``point(s)``, ``tangent(s)``, ``breaks`` and ``s_end`` [m].
+    psi0 : array_like, shape (N,)
+        Initial headings [rad].
+    rtol, atol : float
+        Tolerances of the integration.
+
+    Returns
+    -------
+    KinematicRun
+    """
+    from scipy.integrate import solve_ivp
+    geometry = tuple(unit_geometry(vehicle))
+    f = _rhs(geometry, path)
+    y = np.asarray(psi0, dtype=float).copy()
+    pieces = []
+    breaks = path.breaks
+    for lo, hi in zip(breaks[:-1], breaks[1:]):
+        if hi <= lo:
+            continue
+        sol = solve_ivp(f, (lo, hi), y, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
+        if not sol.success:            # pragma: no cover - DOP853 on a smooth, bounded field
+            raise KinematicsError(f"the heading integration failed: {sol.message}")
+        pieces.append((lo, sol.sol))
+        y = sol.y[:, -1]
+    return KinematicRun(vehicle, path, geometry, tuple(pieces), float(path.s_end))
