@@ -15,9 +15,10 @@ export PYTHONHASHSEED=0
 export SOURCE_DATE_EPOCH=1312156800   # 2011-08-01, the dissertation's date: reproducible PDFs
 
 # Debian packages: LaTeX route of nbconvert (PDF), MathJax for the offline HTML,
-# TBB for ecos, poppler for PDF checks, valgrind and gcc for the native FMU.
+# TBB for ecos, poppler for PDF checks, valgrind and gcc for the native FMU, cmake and make
+# for `fmpy compile` (a test rebuilds the native FMU from its sources/).
 APT_PACKAGES=(texlive-xetex texlive-latex-recommended texlive-fonts-recommended texlive-plain-generic pandoc libjs-mathjax
-              fonts-dejavu-core libtbb12 poppler-utils valgrind gcc)
+              fonts-dejavu-core libtbb12 poppler-utils valgrind gcc cmake make)
 
 log() { printf '[build.sh] %s\n' "$*" >&2; }
 

@@ -1,5 +1,8 @@
 """The slave module pythonfmu loads from the FMU's resources: the class is
-:class:`lcvreport.fmu.slave.LCV` (the package bundled next to this file).
+:class:`lcvreport.fmu.slave.LCV` of the package bundled next to this file, under a name of
+its own (``lcvreport_fmu_<hash>``, written in by the build where ``lcvreport`` stands
+below), so a Python host that has imported another ``lcvreport`` -- another version, an
+editable checkout -- neither runs it nor is disturbed by it.
 
 pythonfmu 0.7.0 (``findClass`` in its PySlaveInstance.cpp) executes this file again on
 every fmi2Instantiate to find the class, and each time (a) keeps every class the file

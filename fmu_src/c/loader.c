@@ -108,6 +108,7 @@ typedef struct {
     int logging_on;                       /* the host's flag: messages below fmi2Warning only then */
     int phase;
     char *name;
+    char *folder;                         /* the resources folder (taken off sys.path at the last free) */
 } Wrapper;
 
 /* an FMU state: pythonfmu's and the phase */
@@ -186,17 +187,31 @@ typedef void (*config_clear_t)(PyConfig *);
 typedef int (*status_exception_t)(PyStatus);
 
 /* run Python code with the GIL held; returns PyRun_SimpleString's result */
-static int run_python(void *py, const char *code)
+/* Run ``code`` in a namespace of its own: PyRun_SimpleString runs in the host's __main__, so
+ * the code travels as hex inside one exec() that binds nothing there.  ``arg`` (may be NULL)
+ * is given to the code as the str ``arg``, also as hex (paths are never pasted into code). */
+static int run_python_arg(void *py, const char *code, const char *arg)
 {
     gil_ensure_t ensure = (gil_ensure_t)dlsym(py, "PyGILState_Ensure");
     gil_release_t release = (gil_release_t)dlsym(py, "PyGILState_Release");
     run_t run = (run_t)dlsym(py, "PyRun_SimpleString");
     if (!ensure || !release || !run) return -1;
+    size_t nc = strlen(code), na = arg ? strlen(arg) : 0;
+    char *wrapped = (char *)malloc(2 * (nc + na) + 256);
+    if (!wrapped) return -1;
+    int k = sprintf(wrapped, "exec(bytes.fromhex('");
+    for (size_t i = 0; i < nc; ++i) k += sprintf(wrapped + k, "%02x", (unsigned char)code[i]);
+    k += sprintf(wrapped + k, "').decode(), {'__name__': '__lcv_fmu_loader__', 'arg': bytes.fromhex('");
+    for (size_t i = 0; i < na; ++i) k += sprintf(wrapped + k, "%02x", (unsigned char)arg[i]);
+    sprintf(wrapped + k, "').decode('utf-8', 'surrogateescape')})\n");
     int g = ensure();
-    int r = run(code);
+    int r = run(wrapped);
     release(g);
+    free(wrapped);
     return r;
 }
+
+static int run_python(void *py, const char *code) { return run_python_arg(py, code, NULL); }
 
 static int status_failed(void *py, PyStatus st, const char *what)
 {
@@ -243,18 +258,37 @@ static int start_python(void *py, const char *libpython)
     return 1;
 }
 
-/* site.addsitedir(path) without pasting the path into code: it travels as hex */
-static int add_site_dir(void *py, const char *site)
+/* The recorded site-packages (numpy).  In the FMU's own interpreter: site.addsitedir.  In a
+ * Python host's: nothing if the host has numpy; else the folder on sys.path only while numpy
+ * is imported (no .pth files run, no finder installed, sys.path as the host had it). */
+static int add_site_dir(void *py, const char *site, int own_interpreter)
 {
-    size_t n = strlen(site);
-    char *code = (char *)malloc(2 * n + 256);
-    if (!code) return -1;
-    int k = sprintf(code, "import sys, site\np = bytes.fromhex('");
-    for (size_t i = 0; i < n; ++i) k += sprintf(code + k, "%02x", (unsigned char)site[i]);
-    sprintf(code + k, "').decode('utf-8', 'surrogateescape')\nif p not in sys.path: site.addsitedir(p)\n");
-    int r = run_python(py, code);
-    free(code);
-    return r;
+    return run_python_arg(py, own_interpreter ?
+        "import sys, site\nif arg not in sys.path: site.addsitedir(arg)\n" :
+        "import sys, importlib.util\n"
+        "if importlib.util.find_spec('numpy') is None:\n"
+        "    sys.path.append(arg)\n"
+        "    try:\n"
+        "        import numpy\n"
+        "    finally:\n"
+        "        sys.path.remove(arg)\n", site);
+}
+
+/* pythonfmu puts the resources folder on sys.path and leaves it there: take it away when the
+ * last instance of this FMU is freed (the modules it imported stay imported, as any import) */
+static pthread_mutex_t live_lock = PTHREAD_MUTEX_INITIALIZER;
+static int live_instances = 0;
+static void *python_lib = NULL;           /* RTLD_DEFAULT (NULL) in a Python host */
+static int python_ready = 0;
+
+static void forget_resources(const char *folder)
+{
+    if (!python_ready) return;
+    (void)run_python_arg(python_lib,
+        "import os, sys\n"
+        "mine = os.path.realpath(arg)\n"
+        "sys.path[:] = [p for p in sys.path if not (isinstance(p, str) and p and os.path.realpath(p) == mine)]\n",
+        folder);
 }
 
 static void bring_up(void)
@@ -296,11 +330,13 @@ static void bring_up(void)
                      site, LOADER_PYTHON_VERSION);
             return;
         }
-        if (add_site_dir(py, site) != 0) {
+        if (add_site_dir(py, site, started) != 0) {
             snprintf(load_error, sizeof load_error, "cannot add %.1200s to the Python path", site);
             return;
         }
     }
+    python_lib = py;
+    python_ready = 1;
     if (run_python(py, "import numpy\n") != 0) {
         snprintf(load_error, sizeof load_error, "numpy cannot be imported by the Python in this process (%s); set "
                  "LCV_FMU_SITE_PACKAGES to the site-packages of an environment that has numpy", started ?
@@ -532,8 +568,8 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     }
     Wrapper *w = (Wrapper *)calloc(1, sizeof(Wrapper));
     char *uri = (char *)malloc(strlen(folder) + 8);
-    if (!w || !uri || !(w->name = strdup(name))) {
-        free(w ? w->name : NULL);
+    if (!w || !uri || !(w->name = strdup(name)) || !(w->folder = strdup(folder))) {
+        if (w) { free(w->name); free(w->folder); }
         free(w);
         free(uri);
         say_once(functions, name, "out of memory");
@@ -547,11 +583,13 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     w->logging_on = loggingOn ? 1 : 0;
     w->phase = PhaseInstantiated;
     /* logging on inside: pythonfmu drops every message otherwise, and the status with it */
+    pthread_mutex_lock(&live_lock);
+    ++live_instances;
+    pthread_mutex_unlock(&live_lock);
     w->inner = p_fmi2Instantiate(w->name, fmuType, fmuGUID, uri, &w->own, visible, fmi2True);
     free(uri);
     if (!w->inner) {
-        free(w->name);
-        free(w);
+        fmi2FreeInstance(w);
         return NULL;
     }
     return w;
@@ -561,8 +599,13 @@ void fmi2FreeInstance(fmi2Component c)
 {
     Wrapper *w = (Wrapper *)c;
     if (!w) return;
-    if (!w->dead) p_fmi2FreeInstance(w->inner);
+    if (w->inner && !w->dead) p_fmi2FreeInstance(w->inner);
+    pthread_mutex_lock(&live_lock);
+    int last = --live_instances == 0;
+    pthread_mutex_unlock(&live_lock);
+    if (last) forget_resources(w->folder);
     free(w->name);
+    free(w->folder);
     free(w);
 }
 

@@ -52,8 +52,12 @@ UNITS = {"speed": "m/s", "angle": "rad", "rate": "rad/s", "force": "N", "moment"
 #: vehicle FMUs show km/h, degrees and SI
 DISPLAY_UNITS = {
     "thesis": {"speed": "mph", "angle": "deg", "rate": "deg/s", "force": "lbf", "moment": "lbf.ft", "length": "in"},
-    "si": {"speed": "km/h", "angle": "deg", "rate": "deg/s"},
+    "si": {"speed": "km/h", "angle": "deg", "rate": "deg/s", "accel": "g", "per_s": "1/min", "force": "kN",
+           "moment": "kN.m", "length": "mm"},
 }
+#: the physical quantity of each kind (modelDescription ``<TypeDefinitions>``)
+QUANTITIES = {"speed": "Velocity", "angle": "Angle", "rate": "AngularVelocity", "force": "Force", "moment": "Torque",
+              "length": "Length", "accel": "Acceleration", "per_s": "Rate", "factor": "Factor", "percent": "Slope"}
 
 
 @dataclass(frozen=True)
@@ -169,11 +173,14 @@ class _Table:
         self.vars: list[FmuVariable] = []
         self.display = DISPLAY_UNITS[display]
 
-    def add(self, name, causality, variability, quantity, start, description, source, type_="Real", range_key=None):
+    def add(self, name, causality, variability, quantity, start, description, source, type_="Real", range_key=None,
+            maximum=None):
         lo = hi = None
         if range_key is not None:
             r = RANGES[range_key]
             lo, hi = r.low, r.high
+        if maximum is not None:
+            hi = maximum
         self.vars.append(FmuVariable(name, len(self.vars), causality, variability, type_, quantity, start,
                                      description, source, lo, hi, self.display.get(quantity, "")))
 
@@ -193,7 +200,7 @@ def _parameters(t: _Table) -> None:
 def _speed_and_steer(t: _Table, steer_text: str, u_start: float = U_START) -> None:
     t.add("u", "input", "continuous", "speed", u_start,
           f"Forward speed of every unit, held over each communication step; at most {RANGES['speed'].high:g} m/s",
-          ("speed",))
+          ("speed",), maximum=RANGES["speed"].high)
     t.add("delta", "input", "continuous", "angle", 0.0,
           f"Steer angle of {steer_text}, positive nose-right (toward +y), in {RANGES['steer_angle'].text()}",
           ("steer",), range_key="steer_angle")

@@ -29,9 +29,10 @@ UNIT_DEFINITIONS = {
     "rad": ({"rad": 1}, [("deg", 180.0 / math.pi)]),
     "rad/s": ({"rad": 1, "s": -1}, [("deg/s", 180.0 / math.pi)]),
     "N": ({"kg": 1, "m": 1, "s": -2}, [("lbf", 1 / N_PER_LBF), ("kN", 1e-3)]),
-    "N.m": ({"kg": 1, "m": 2, "s": -2}, [("lbf.ft", 1 / NM_PER_LBF_FT), ("lbf.in", 1 / NM_PER_LBF_IN)]),
+    "N.m": ({"kg": 1, "m": 2, "s": -2}, [("lbf.ft", 1 / NM_PER_LBF_FT), ("lbf.in", 1 / NM_PER_LBF_IN),
+                                        ("kN.m", 1e-3)]),
     "m/s2": ({"m": 1, "s": -2}, [("g", 1 / 9.80665)]),
-    "1/s": ({"s": -1}, []),
+    "1/s": ({"s": -1}, [("1/min", 60.0)]),
     "1": ({}, []),
     "%": ({"factor": 0.01}, []),
 }
@@ -43,6 +44,10 @@ LOG_CATEGORIES = {
 }
 #: default experiment
 DEFAULT_EXPERIMENT = {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.001"}
+
+
+#: the C sources of the native FMU listed in ``<SourceFiles>`` (``fmpy compile`` rebuilds it)
+NATIVE_SOURCE_FILES = ("fmi2_api.c", "fmi2_shared.c", "model.c", "linalg.c")
 
 
 def _direct_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
@@ -94,18 +99,23 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
         True for the C FMU (no execution tool); False for the pythonfmu FMU.
     generation_tool : str
     """
+    from .interface import QUANTITIES
     root = Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": model_identifier, "guid": guid(itf, model_identifier),
         "description": itf.description + ("" if not native else " Native C implementation: no Python at run time."),
         "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": generation_tool,
         "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
-    SubElement(root, "CoSimulation", {
-        "modelIdentifier": model_identifier, "needsExecutionTool": "false",
+    cs = SubElement(root, "CoSimulation", {
+        "modelIdentifier": model_identifier, "needsExecutionTool": "false" if native else "true",
         "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
         "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
         "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
         "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
         "providesDirectionalDerivative": "false"})
+    if native:                  # the official headers come with the importer (fmpy's c-code), not in sources/
+        files = SubElement(cs, "SourceFiles")
+        for name in NATIVE_SOURCE_FILES:
+            SubElement(files, "File", name=name)
     used = sorted({v.unit for v in itf.variables if v.unit})
     defs = SubElement(root, "UnitDefinitions")
     for name in used:
@@ -114,6 +124,22 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
         SubElement(unit, "BaseUnit", {k: str(e) for k, e in base.items()})
         for dname, factor in displays:
             SubElement(unit, "DisplayUnit", {"name": dname, "factor": _num(factor)})
+    types = SubElement(root, "TypeDefinitions")
+    declared = {}
+    for v in itf.variables:
+        if v.type != "Real" or v.quantity not in QUANTITIES:
+            continue
+        key = (v.quantity, v.display_unit)
+        if key not in declared:
+            name = QUANTITIES[v.quantity] + (f"_{v.display_unit.replace('/', '_per_').replace('.', '_')}"
+                                             if v.display_unit else "")
+            declared[key] = name
+            real = {"quantity": QUANTITIES[v.quantity]}
+            if v.unit:
+                real["unit"] = v.unit
+            if v.display_unit:
+                real["displayUnit"] = v.display_unit
+            SubElement(SubElement(types, "SimpleType", name=name), "Real", real)
     cats = SubElement(root, "LogCategories")
     for name, text in LOG_CATEGORIES.items():
         SubElement(cats, "Category", name=name, description=text)
@@ -131,13 +157,17 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
             SubElement(sv, "String", {"start": str(v.start)})
             continue
         real = {}
+        if (v.quantity, v.display_unit) in declared:
+            real["declaredType"] = declared[(v.quantity, v.display_unit)]
         if v.unit:
             real["unit"] = v.unit
         if v.display_unit:
             real["displayUnit"] = v.display_unit
-        if v.minimum is not None and v.causality == "parameter":
-            real["min"] = _num(v.minimum)
-            real["max"] = _num(v.maximum)
+        if v.causality in ("parameter", "input"):   # what the FMU refuses, from the ranges table
+            if v.minimum is not None:
+                real["min"] = _num(v.minimum)
+            if v.maximum is not None:
+                real["max"] = _num(v.maximum)
         if v.start is not None:
             real["start"] = _num(v.start)
         SubElement(sv, "Real", real)
@@ -145,11 +175,11 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
     ms = SubElement(root, "ModelStructure")
     outs = SubElement(ms, "Outputs")
     init = SubElement(ms, "InitialUnknowns")
-    for v in itf.outputs:
-        deps = " ".join(str(index[n]) for n in _direct_dependencies(itf, v))
+    for v in itf.outputs:                  # dependencies in ascending order (FMI 2.0.4, section 2.2.8)
+        deps = " ".join(str(i) for i in sorted(index[n] for n in _direct_dependencies(itf, v)))
         SubElement(outs, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
     for v in itf.outputs:
-        deps = " ".join(str(index[n]) for n in _initial_dependencies(itf, v))
+        deps = " ".join(str(i) for i in sorted(index[n] for n in _initial_dependencies(itf, v)))
         SubElement(init, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
     indent(root)
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + tostring(root, encoding="utf-8") + b"\n"

@@ -24,10 +24,10 @@ import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real, String
 from pythonfmu.enums import Fmi2Status
 
-from lcvreport.fmu.engine import CosimError, LCVEngine, state_from_bytes, state_to_bytes
-from lcvreport.fmu.model_description import model_description
-from lcvreport.fmu.interface import U_START, preset_interface, vehicle_interface
-from lcvreport.model.vehicle_file import load_vehicle
+from ..model.vehicle_file import load_vehicle
+from .engine import CosimError, LCVEngine, state_from_bytes, state_to_bytes
+from .interface import U_START, preset_interface, vehicle_interface
+from .model_description import model_description
 
 
 def _interface(resources: str):

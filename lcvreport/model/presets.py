@@ -46,7 +46,8 @@ def check_preset(name: str) -> str:
 
 def preset_path(name: str):
     """The shipped vehicle file of preset ``name`` (an importlib resource)."""
-    return resources.files("lcvreport").joinpath("data", "vehicles", f"{check_preset(name)}.toml")
+    # the top package by its own name: inside a Python FMU it is bundled under a name of its own
+    return resources.files(__package__.partition(".")[0]).joinpath("data", "vehicles", f"{check_preset(name)}.toml")
 
 
 @lru_cache(maxsize=None)

@@ -1,0 +1,54 @@
+"""The Python FMU in a Python host (issue 20): the host is left as it was found (sys.path,
+meta-path finders, path hooks, __main__'s names) after fmi2FreeInstance, and the FMU runs its
+own bundled package even when the host imported another ``lcvreport`` first."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).parent
+
+
+def _host(fmu: Path, *args: str, flags=()) -> dict:
+    p = subprocess.run([sys.executable, *flags, str(HERE / "python_host.py"), str(fmu), *args], capture_output=True,
+                       text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-3000:]
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+@pytest.fixture(scope="module")
+def reference_r1(native_fmu):
+    """r1 after 1 s of a 0.01 rad steer step, from the native FMU (equal to the package's
+    exact response, tests/test_fmu.py)."""
+    from fmpy import simulate_fmu
+    inp = np.array([(0.0, 0.01), (1.0, 0.01)], dtype=[("time", float), ("delta", float)])
+    res = simulate_fmu(str(native_fmu), stop_time=1.0, step_size=0.1, output_interval=0.1, input=inp,
+                       output=["r1"])
+    return float(res["r1"][-1])
+
+
+@pytest.mark.parametrize("case, flags, fake", [("venv host", (), False), ("host without site-packages", ("-S",), False),
+                                               ("host with another lcvreport", (), True)])
+def test_the_host_is_left_as_it_was(lcv_fmu, tmp_path, reference_r1, case, flags, fake):
+    args = ()
+    if fake:
+        pkg = tmp_path / "fake" / "lcvreport"
+        pkg.mkdir(parents=True)
+        (pkg / "__init__.py").write_text("raise_if_used = True\n")
+        (pkg / "fmu").mkdir()
+        (pkg / "fmu" / "__init__.py").write_text("raise RuntimeError('the host copy was run')\n")
+        args = (str(tmp_path / "fake"),)
+    out = _host(lcv_fmu, *args, flags=flags)
+    assert out["ok"] and not out["messages"], (case, out)
+    assert out["changed"] == {"path": [], "meta": [], "hooks": []}, (case, out)
+    assert out["main_added"] == [], (case, out)
+    assert out["r1"] == pytest.approx(reference_r1, rel=1e-12), case
+    if fake:
+        assert out["lcvreport"] == str(tmp_path / "fake" / "lcvreport" / "__init__.py")   # still the host's
+    if flags:
+        assert out["numpy_from"] and "site-packages" in out["numpy_from"]      # the recorded site-packages
