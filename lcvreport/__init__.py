@@ -48,6 +48,7 @@ Where things live (the folders are the layers; each imports only the ones above 
 ``fmu/``                 **the FMUs**:
     ``interface``        the one interface table (SPEC sections 5 and 9)
     ``model_description`` modelDescription.xml from that table
+    ``model_description3`` the FMI 3.0 modelDescription.xml and buildDescription.xml
     ``engine``           the co-simulation engine (numpy only)
     ``slave``            the pythonfmu slave class, a thin map onto the engine
     ``build``            builders of the pythonfmu and the C FMU (sources in the

@@ -163,11 +163,13 @@ def build_parser() -> argparse.ArgumentParser:
     residuals(mea)
     mea.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
     mea.add_argument("--json", action="store_true", help="machine-readable output")
-    fmu = sub.add_parser("fmu", help="FMI 2.0 co-simulation FMUs of the vehicle")
+    fmu = sub.add_parser("fmu", help="FMUs of the vehicle (FMI 2.0 or 3.0; native: Co-Simulation and Model Exchange)")
     source(fmu, masses=False)
     fmu.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    fmu.add_argument("--kind", default="both", choices=("python", "native", "both"),
-                     help="python (pythonfmu), native (C99) or both (default)")
+    fmu.add_argument("--kind", default=None, choices=("python", "native", "both"),
+                     help="python (pythonfmu), native (C99) or both (default: both for FMI 2.0, native for 3.0)")
+    fmu.add_argument("--fmi", default="2", choices=("2", "3"),
+                     help="FMI version (default 2); FMI 3.0 is built native only so far")
     speed(fmu, required=False)
     rep = sub.add_parser("report", help="assessment report of the vehicle (HTML and PDF)")
     source(rep, masses=False)
@@ -635,7 +637,11 @@ def _cmd_fmu(args, out: _Out) -> int:
         kw = {}
         if args.speed_kph is not None or args.speed_mph is not None:
             kw["u_start_mps"] = _speed_mps(args)      # the start value of the input u
-        paths = build_vehicle_fmus(v, args.out, kind=args.kind, **kw)
+        kind = args.kind or ("both" if args.fmi == "2" else "native")
+        if args.fmi == "3" and kind != "native":
+            raise UsageError(f"argument --kind: FMI 3.0 FMUs are built native only (the Python FMU is FMI 2.0 so "
+                             f"far); use --kind native, got {kind}")
+        paths = build_vehicle_fmus(v, args.out, kind=kind, fmi=int(args.fmi), **kw)
     except FmuBuildError as exc:
         raise OutputError(str(exc)) from None
     for p in paths:

@@ -135,7 +135,8 @@ print(",".join(heavy))
 
 
 @pytest.mark.parametrize("package, names", [
-    ("lcvreport.fmu_src", ["LCV.py", "c/fmi2_api.c", "c/model.c", "c/linalg.c", "c/loader.c", "c/model_stub.c"]),
+    ("lcvreport.fmu_src", ["LCV.py", "c/fmi2_api.c", "c/fmi3_api.c", "c/model.c", "c/linalg.c", "c/loader.c",
+                           "c/model_stub.c"]),
     ("lcvreport.notebooks", [f"{s}.ipynb" for s in ("ch1_2_concepts", "ch3_tractor_semitrailer", "ch4_triple",
                                                     "ch5_parametric", "ch6_tracking", "appendices", "audit",
                                                     "assessment")]),

@@ -42,9 +42,11 @@ def test_sources_are_listed_and_the_official_headers_not_shipped(every_fmu):
         names = zipfile.ZipFile(path).namelist()
         official = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
         assert not [n for n in names if n.split("/")[-1] in official], name
-        files = [f.get("name") for f in _xml(path).iter("File")]
+        root = _xml(path)
         if native:
-            assert files == ["fmi2_api.c", "fmi2_shared.c", "model.c", "linalg.c"], name
+            for kind in ("ModelExchange", "CoSimulation"):
+                files = [f.get("name") for f in root.find(kind).iter("File")]
+                assert files == ["fmi2_api.c", "fmi2_shared.c", "model.c", "linalg.c"], (name, kind)
             assert all(f"sources/{f}" in names for f in files), name
 
 
@@ -120,6 +122,9 @@ def test_display_units_and_quantities(every_fmu, all_example_fmus):
             real = sv[0]
             if real.tag != "Real":
                 continue
+            if sv.get("causality") == "local":             # der(x): the unit of the state's derivative
+                assert real.get("derivative") and real.get("unit"), (name, sv.get("name"))
+                continue
             declared = types[real.get("declaredType")]
             assert declared.get("quantity") and declared.get("unit") == real.get("unit"), (name, sv.get("name"))
             if real.get("displayUnit"):
@@ -129,7 +134,14 @@ def test_display_units_and_quantities(every_fmu, all_example_fmus):
 
 
 def test_the_interface_table_and_the_xml_agree(every_fmu):
-    for name, path, _native in every_fmu:
+    for name, path, native in every_fmu:
         itf = interface_of(path)
-        xml_names = [sv.get("name") for sv in _xml(path).iter("ScalarVariable")]
-        assert xml_names == [v.name for v in itf.variables], name
+        svs = list(_xml(path).iter("ScalarVariable"))
+        assert [sv.get("name") for sv in svs if sv.get("causality") != "local"] == [v.name for v in itf.variables]
+        ders = [sv for sv in svs if sv.get("causality") == "local"]
+        if native:                                         # der(x) of every Model Exchange state, in order
+            index = {sv.get("name"): k + 1 for k, sv in enumerate(svs)}
+            assert [sv.get("name") for sv in ders] == [f"der({v.name})" for v in itf.continuous_states], name
+            assert [int(sv[0].get("derivative")) for sv in ders] == [index[v.name] for v in itf.continuous_states]
+        else:
+            assert ders == [], name

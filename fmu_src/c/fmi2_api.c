@@ -19,14 +19,27 @@
 #include "fmi2_shared.h"
 #include "model.h"
 
-/* phases a call is allowed in */
+/* phases a call is allowed in (Model Exchange: EventMode and ContinuousTimeMode after
+   initialization instead of StepComplete) */
+#define RUNNING (PhaseStepComplete | PhaseEventMode | PhaseContinuousTimeMode)
 #define MASK_fmi2SetupExperiment PhaseInstantiated
 #define MASK_fmi2EnterInitializationMode PhaseInstantiated
 #define MASK_fmi2ExitInitializationMode PhaseInitializationMode
-#define MASK_fmi2Terminate (PhaseStepComplete | PhaseError)
+#define MASK_fmi2Terminate (RUNNING | PhaseError)
 #define MASK_fmi2DoStep PhaseStepComplete
 #define MASK_fmi2GetReal ANY_PHASE
-#define MASK_fmi2SetReal (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete)
+#define MASK_fmi2SetReal (PhaseInstantiated | PhaseInitializationMode | RUNNING)
+#define MASK_fmi2SetTime (PhaseEventMode | PhaseContinuousTimeMode)
+#define MASK_fmi2SetContinuousStates (PhaseEventMode | PhaseContinuousTimeMode)
+#define MASK_fmi2GetDerivatives (PhaseInitializationMode | PhaseEventMode | PhaseContinuousTimeMode | \
+                                 PhaseTerminated | PhaseError)
+#define MASK_fmi2GetEventIndicators MASK_fmi2GetDerivatives
+#define MASK_fmi2GetContinuousStates MASK_fmi2GetDerivatives
+#define MASK_fmi2GetNominalsOfContinuousStates (PhaseInstantiated | MASK_fmi2GetDerivatives)
+#define MASK_fmi2EnterEventMode (PhaseEventMode | PhaseContinuousTimeMode)
+#define MASK_fmi2NewDiscreteStates PhaseEventMode
+#define MASK_fmi2EnterContinuousTimeMode PhaseEventMode
+#define MASK_fmi2CompletedIntegratorStep PhaseContinuousTimeMode
 #define MASK_fmi2SetString (PhaseInstantiated | PhaseInitializationMode)
 #define MASK_fmi2GetString ANY_PHASE
 
@@ -82,9 +95,9 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     (void)fmuResourceLocation; (void)visible;
     if (!functions || !functions->logger) return NULL;
     const char *name = instanceName ? instanceName : LCV_MODEL_IDENTIFIER_TEXT;
-    if (fmuType != fmi2CoSimulation) {
+    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
         functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
-                          LCV_MODEL_IDENTIFIER_TEXT " supports co-simulation only");
+                          "fmuType must be fmi2ModelExchange or fmi2CoSimulation");
         return NULL;
     }
     if (!fmuGUID || strcmp(fmuGUID, LCV_GUID) != 0) {
@@ -102,6 +115,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     if (!c->name) { free(c); return NULL; }
     strcpy(c->name, name);
     c->logging_on = loggingOn;
+    c->model_exchange = fmuType == fmi2ModelExchange;
     model_reset(c);
     return c;
 }
@@ -145,7 +159,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component comp)
         return fmi2Error;
     }
     c->s.time = t0;
-    c->s.phase = PhaseStepComplete;
+    c->s.phase = c->model_exchange ? PhaseEventMode : PhaseStepComplete;
     return fmi2OK;
 }
 
@@ -283,6 +297,114 @@ fmi2Status fmi2CancelStep(fmi2Component comp)
     return fmi2Error;
 }
 
+/* ------------------------------------------------------------------ Model Exchange */
+fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time)
+{
+    BEGIN_FUNCTION(SetTime)
+    if (!isfinite(time)) { logmsg(c, fmi2Error, "fmi2SetTime: time is not finite (%g)", time); return fmi2Error; }
+    c->s.time = time;
+    return fmi2OK;
+}
+
+static int states_arg(ModelInstance *c, const char *function, const void *x, size_t nx)
+{
+    if (nx != LCV_N_ME_STATES) {
+        logmsg(c, fmi2Error, "%s: %u states given, this FMU has %u", function, (unsigned)nx, (unsigned)LCV_N_ME_STATES);
+        return 0;
+    }
+    if (!x) { logmsg(c, fmi2Error, "%s: null array", function); return 0; }
+    return 1;
+}
+
+fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_t nx)
+{
+    BEGIN_FUNCTION(SetContinuousStates)
+    if (!states_arg(c, "fmi2SetContinuousStates", x, nx)) return fmi2Error;
+    for (size_t i = 0; i < nx; ++i)
+        if (!isfinite(x[i])) {
+            logmsg(c, fmi2Error, "fmi2SetContinuousStates: state %s is not finite (%g); the states are unchanged",
+                   LCV_VARIABLE_NAME(LCV_ME_STATE_VR_OF(i)), x[i]);
+            return fmi2Error;
+        }
+    model_set_states(c, x, nx);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetContinuousStates(fmi2Component comp, fmi2Real x[], size_t nx)
+{
+    BEGIN_FUNCTION(GetContinuousStates)
+    if (!states_arg(c, "fmi2GetContinuousStates", x, nx)) return fmi2Error;
+    model_get_states(c, x, nx);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx)
+{
+    BEGIN_FUNCTION(GetDerivatives)
+    if (!states_arg(c, "fmi2GetDerivatives", dx, nx)) return fmi2Error;
+    int r = model_derivatives(c, dx, nx);
+    if (r < 0) { logmsg(c, fmi2Error, "%s", c->msg); return fmi2Error; }
+    if (r > 0) logmsg(c, fmi2Warning, "%s", c->msg);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real x_nominal[], size_t nx)
+{
+    BEGIN_FUNCTION(GetNominalsOfContinuousStates)
+    if (!states_arg(c, "fmi2GetNominalsOfContinuousStates", x_nominal, nx)) return fmi2Error;
+    for (size_t i = 0; i < nx; ++i) x_nominal[i] = 1.0;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetEventIndicators(fmi2Component comp, fmi2Real eventIndicators[], size_t ni)
+{
+    BEGIN_FUNCTION(GetEventIndicators)
+    (void)eventIndicators;
+    if (ni != 0) { logmsg(c, fmi2Error, "fmi2GetEventIndicators: this FMU has no event indicators"); return fmi2Error; }
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterEventMode(fmi2Component comp)
+{
+    BEGIN_FUNCTION(EnterEventMode)
+    c->s.phase = PhaseEventMode;
+    return fmi2OK;
+}
+
+fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *eventInfo)
+{
+    BEGIN_FUNCTION(NewDiscreteStates)
+    if (!eventInfo) { logmsg(c, fmi2Error, "fmi2NewDiscreteStates: null pointer"); return fmi2Error; }
+    eventInfo->newDiscreteStatesNeeded = fmi2False;
+    eventInfo->terminateSimulation = fmi2False;
+    eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
+    eventInfo->valuesOfContinuousStatesChanged = fmi2False;
+    eventInfo->nextEventTimeDefined = fmi2False;
+    eventInfo->nextEventTime = 0.0;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component comp)
+{
+    BEGIN_FUNCTION(EnterContinuousTimeMode)
+    c->s.phase = PhaseContinuousTimeMode;
+    return fmi2OK;
+}
+
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component comp, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation)
+{
+    (void)noSetFMUStatePriorToCurrentPoint;
+    BEGIN_FUNCTION(CompletedIntegratorStep)
+    if (!enterEventMode || !terminateSimulation) {
+        logmsg(c, fmi2Error, "fmi2CompletedIntegratorStep: null pointer");
+        return fmi2Error;
+    }
+    *enterEventMode = fmi2False;
+    *terminateSimulation = fmi2False;
+    return fmi2OK;
+}
+
 /* ------------------------------------------------------------------ FMU state */
 #define STATE_MAGIC 0x4C43564EU          /* "LCVN" */
 typedef struct {
@@ -395,13 +517,22 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte serialized
 }
 
 /* ------------------------------------------------------------------ not provided */
+#define MASK_fmi2GetDirectionalDerivative (PhaseInitializationMode | RUNNING | PhaseTerminated | PhaseError)
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[])
 {
-    (void)vUnknown_ref; (void)nUnknown; (void)vKnown_ref; (void)nKnown; (void)dvKnown; (void)dvUnknown;
-    if (comp) logmsg((ModelInstance *)comp, fmi2Error, "directional derivatives are not provided");
-    return fmi2Error;
+    BEGIN_FUNCTION(GetDirectionalDerivative)
+    if (nUnknown == 0) return fmi2OK;
+    if (!vUnknown_ref || !dvUnknown || (nKnown > 0 && (!vKnown_ref || !dvKnown))) {
+        logmsg(c, fmi2Error, "fmi2GetDirectionalDerivative: null array");
+        return fmi2Error;
+    }
+    if (model_directional(c, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown) != 0) {
+        logmsg(c, fmi2Error, "%s", c->msg);
+        return fmi2Error;
+    }
+    return fmi2OK;
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,

@@ -28,6 +28,8 @@ const char *phase_name(int phase)
     case PhaseInitializationMode: return "InitializationMode";
     case PhaseStepComplete: return "StepComplete";
     case PhaseTerminated: return "Terminated";
+    case PhaseEventMode: return "EventMode";
+    case PhaseContinuousTimeMode: return "ContinuousTimeMode";
     default: return "Error";
     }
 }
@@ -37,6 +39,7 @@ const char *log_category(fmi2Status status)
     return status == fmi2Warning ? "logStatusWarning" : status >= fmi2Error ? "logStatusError" : "logAll";
 }
 
+#ifndef LCV_FMI3          /* the FMI 3.0 binary exports no fmi2 function */
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
 {
     (void)s;
@@ -58,3 +61,4 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     if (!c || !value) return fmi2Error;
     return fmi2Discard;
 }
+#endif

@@ -22,9 +22,12 @@ typedef enum {
     PhaseInitializationMode = 1 << 1,
     PhaseStepComplete = 1 << 2,
     PhaseTerminated = 1 << 3,
-    PhaseError = 1 << 4
+    PhaseError = 1 << 4,
+    PhaseEventMode = 1 << 5,              /* Model Exchange */
+    PhaseContinuousTimeMode = 1 << 6      /* Model Exchange */
 } Phase;
-#define ANY_PHASE (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError)
+#define ANY_PHASE (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError | \
+                   PhaseEventMode | PhaseContinuousTimeMode)
 
 /* the name of a phase, for messages */
 const char *phase_name(int phase);

@@ -315,6 +315,180 @@ int model_do_step(ModelInstance *c, double h)
     return warn;
 }
 
+/* ------------------------------------------------------------------ Model Exchange */
+const char *model_variable_name(unsigned vr)
+{
+    return vr < LCV_N_VARIABLES ? LCV_VARIABLE_NAMES[vr] : "?";
+}
+
+unsigned model_me_state_vr(size_t k) { return k < LCV_N_ME_STATES ? LCV_ME_STATE_VR[k] : 0u; }
+
+void model_get_states(ModelInstance *c, double x[], size_t nx)
+{
+    const LcvVehicle *v = vehicle_of(c);
+    for (size_t k = 0; k < nx && k < LCV_N_ME_STATES; ++k) {
+        int j = v ? v->me_z[k] : -1;
+        x[k] = j >= 0 ? c->s.z[j] : 0.0;
+    }
+}
+
+void model_set_states(ModelInstance *c, const double x[], size_t nx)
+{
+    const LcvVehicle *v = vehicle_of(c);
+    if (!v) return;
+    for (size_t k = 0; k < nx && k < LCV_N_ME_STATES; ++k) {
+        int j = v->me_z[k];
+        if (j >= 0) c->s.z[j] = x[k];
+    }
+}
+
+/* z' = [M^-1 (S x + Bw w + Fc); r1; v1 + u psi1] at the current inputs (u clamped to u_min):
+   0, 1 with a warning in c->msg (u clamped), -1 with an error in c->msg */
+int model_derivatives(ModelInstance *c, double dx[], size_t nx)
+{
+    const LcvVehicle *v = vehicle_of(c);
+    for (size_t k = 0; k < nx; ++k) dx[k] = 0.0;
+    if (!v) return 0;                                  /* before initialization: at rest */
+    if (check_inputs(c) != 0) return -1;
+    int n = v->n;
+    double u_in = c->s.w[0], u = u_in < c->s.u_min ? c->s.u_min : u_in;
+    int warn = 0, clamped = u_in < c->s.u_min;
+    if (clamped && !c->s.clamped) {
+        snprintf(c->msg, sizeof c->msg, "u = %.6g m/s is below u_min = %.6g m/s; the model runs at u_min until u "
+                 "rises again (the linear model needs a forward speed)", u_in, c->s.u_min);
+        warn = 1;
+    }
+    c->s.clamped = clamped;
+    SpeedEntry *se = speed_entry(c, u);
+    if (!se) {
+        snprintf(c->msg, sizeof c->msg, "the state matrix cannot be evaluated at u = %.6g m/s", u);
+        return -1;
+    }
+    double *M = c->work, *y = M + (size_t)n * n, *ws = y + n;
+    for (int i = 0; i < n * n; ++i) M[i] = v->M0[i] + u * v->M1[i];
+    for (int i = 0; i < n; ++i) {
+        double s = c->Fc[i];
+        for (int j = 0; j < LCV_N_INPUTS; ++j) s += c->Bw[(size_t)i * LCV_N_INPUTS + j] * c->s.w[j];
+        y[i] = s;
+    }
+    if (lcv_solve_scaled(M, n, y, 1, 1, ws) != 0) {
+        snprintf(c->msg, sizeof c->msg, "the mass matrix is singular at u = %.6g m/s", u);
+        return -1;
+    }
+    double dz[LCV_MAX_M];
+    for (int i = 0; i < n; ++i) {
+        double s = y[i];
+        for (int j = 0; j < n; ++j) s += se->A[(size_t)i * n + j] * c->s.z[j];
+        dz[i] = s;
+    }
+    dz[n] = c->s.z[1];                                  /* psi1' = r1 */
+    dz[n + 1] = c->s.z[0] + u * c->s.z[n];              /* Y1' = v1 + u psi1 */
+    for (int i = 0; i < n + 2; ++i)
+        if (!isfinite(dz[i])) {
+            snprintf(c->msg, sizeof c->msg, "the derivatives at t = %.6g s are not finite", c->s.time);
+            return -1;
+        }
+    for (size_t k = 0; k < nx && k < LCV_N_ME_STATES; ++k) {
+        int j = v->me_z[k];
+        dx[k] = j >= 0 ? dz[j] : 0.0;
+    }
+    c->s.last_speed = u;
+    return warn;
+}
+
+/* Directional derivatives (the model is linear in z and in every input but u, for fixed u):
+   knowns are Model Exchange states and inputs other than u; unknowns are derivatives der(x)
+   and outputs other than max_real_eig.  0, or -1 with c->msg. */
+int model_directional(ModelInstance *c, const unsigned unknowns[], size_t nu, const unsigned knowns[], size_t nk,
+                      const double seed[], double out[])
+{
+    const LcvVehicle *v = vehicle_of(c);
+    for (size_t i = 0; i < nu; ++i) out[i] = 0.0;
+    if (!v) return 0;                                  /* before initialization: at rest, nothing depends */
+    int n = v->n, m = n + 2, N = v->n_units;
+    double dz[LCV_MAX_M] = {0}, dw[LCV_N_INPUTS] = {0};
+    for (size_t i = 0; i < nk; ++i) {
+        unsigned r = knowns[i];
+        if (r >= LCV_FIRST_INPUT + 1 && r < LCV_FIRST_INPUT + LCV_N_INPUTS) { dw[r - LCV_FIRST_INPUT] += seed[i]; continue; }
+        int k = -1;
+        for (int j = 0; j < LCV_N_ME_STATES; ++j) if (LCV_ME_STATE_VR[j] == r) { k = j; break; }
+        if (k < 0) {
+            snprintf(c->msg, sizeof c->msg, "directional derivative: known %u (%s) is not a continuous state or an "
+                     "input other than u (the model is nonlinear in u)", r, model_variable_name(r));
+            return -1;
+        }
+        if (v->me_z[k] >= 0) dz[v->me_z[k]] += seed[i];
+    }
+    double u_in = c->s.w[0], u = u_in < c->s.u_min ? c->s.u_min : u_in;
+    if (!(u <= LCV_SPEED_MAX)) { snprintf(c->msg, sizeof c->msg, "input u = %.6g m/s is above %.4g m/s", u_in, LCV_SPEED_MAX); return -1; }
+    SpeedEntry *se = speed_entry(c, u);
+    if (!se) { snprintf(c->msg, sizeof c->msg, "the state matrix cannot be evaluated at u = %.6g m/s", u); return -1; }
+    double ddz[LCV_MAX_M];
+    int need_dynamics = 0;
+    for (size_t i = 0; i < nu; ++i)
+        if (unknowns[i] >= LCV_FIRST_DERIVATIVE && unknowns[i] < LCV_FIRST_DERIVATIVE + LCV_N_ME_STATES) need_dynamics = 1;
+    if (need_dynamics) {                                /* d(z') = A_aug dz + G Bw dw */
+        double *M = c->work, *y = M + (size_t)n * n, *ws = y + n;
+        for (int i = 0; i < n * n; ++i) M[i] = v->M0[i] + u * v->M1[i];
+        for (int i = 0; i < n; ++i) {
+            double s = 0.0;
+            for (int j = 0; j < LCV_N_INPUTS; ++j) s += c->Bw[(size_t)i * LCV_N_INPUTS + j] * dw[j];
+            y[i] = s;
+        }
+        if (lcv_solve_scaled(M, n, y, 1, 1, ws) != 0) {
+            snprintf(c->msg, sizeof c->msg, "the mass matrix is singular at u = %.6g m/s", u);
+            return -1;
+        }
+        for (int i = 0; i < n; ++i) {
+            double s = y[i];
+            for (int j = 0; j < n; ++j) s += se->A[(size_t)i * n + j] * dz[j];
+            ddz[i] = s;
+        }
+        ddz[n] = dz[1];
+        ddz[n + 1] = dz[0] + u * dz[n];
+    }
+    for (size_t i = 0; i < nu; ++i) {
+        unsigned r = unknowns[i];
+        if (r >= LCV_FIRST_DERIVATIVE && r < LCV_FIRST_DERIVATIVE + LCV_N_ME_STATES) {
+            int j = v->me_z[r - LCV_FIRST_DERIVATIVE];
+            out[i] = j >= 0 ? ddz[j] : 0.0;
+            continue;
+        }
+        if (!(r >= LCV_FIRST_OUTPUT && r < LCV_FIRST_OUTPUT + LCV_N_OUTPUTS)) {
+            snprintf(c->msg, sizeof c->msg, "directional derivative: unknown %u (%s) is not an output or a derivative",
+                     r, model_variable_name(r));
+            return -1;
+        }
+        int o = (int)(r - LCV_FIRST_OUTPUT);
+        double s = 0.0;
+        switch (LCV_OUTPUT_KIND[o]) {
+        case LCV_OUT_LINEAR:
+            for (int j = 0; j < m; ++j) s += v->C[(size_t)o * m + j] * dz[j];
+            break;
+        case LCV_OUT_LATERAL:                           /* y = W sin(H z): dy = W cos(H z) H dz */
+            for (int k = 0; k < N - 1; ++k) {
+                double hz = 0.0, hd = 0.0;
+                for (int j = 0; j < m; ++j) { hz += v->H[(size_t)k * m + j] * c->s.z[j]; hd += v->H[(size_t)k * m + j] * dz[j]; }
+                s += v->W[(size_t)o * (N - 1) + k] * cos(hz) * hd;
+            }
+            break;
+        case LCV_OUT_ACCEL: {
+            int iu = v->ay_unit[o];
+            if (iu < 0) break;
+            for (int j = 0; j < n; ++j) s += se->Ca[(size_t)iu * n + j] * dz[j];
+            for (int j = 0; j < LCV_N_INPUTS; ++j) s += se->DaB[(size_t)iu * LCV_N_INPUTS + j] * dw[j];
+            break;
+        }
+        default:
+            snprintf(c->msg, sizeof c->msg, "directional derivative: %s is not differentiable (the largest real part "
+                     "of the eigenvalues)", model_variable_name(r));
+            return -1;
+        }
+        out[i] = s;
+    }
+    return 0;
+}
+
 /* ------------------------------------------------------------------ outputs */
 static double output_speed(const ModelInstance *c)
 {
@@ -397,6 +571,13 @@ int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, 
         }
         if (r >= LCV_FIRST_INPUT && r < LCV_FIRST_INPUT + LCV_N_INPUTS) {
             value[i] = c->s.w[r - LCV_FIRST_INPUT];
+        } else if (r >= LCV_FIRST_DERIVATIVE && r < LCV_FIRST_DERIVATIVE + LCV_N_ME_STATES) {
+            double dx[LCV_N_ME_STATES];
+            int clamped = c->s.clamped;             /* a read does not consume the clamping warning */
+            int d = model_derivatives(c, dx, LCV_N_ME_STATES);
+            c->s.clamped = clamped;
+            value[i] = d < 0 ? 0.0 : dx[r - LCV_FIRST_DERIVATIVE];
+            if (d < 0) status = -1;
         } else if (r >= LCV_FIRST_OUTPUT && r < LCV_FIRST_OUTPUT + LCV_N_OUTPUTS) {
             value[i] = 0.0;
             if (c->s.vehicle < 0) continue;                /* before initialization: at rest */

@@ -55,6 +55,7 @@ typedef struct ModelInstance {
     fmi2CallbackFunctions cb;
     char *name;
     int logging_on;
+    int model_exchange;                                  /* instantiated as fmi2ModelExchange */
     ModelState s;
     double Bw[LCV_MAX_STATES * LCV_N_INPUTS];            /* generalized force per SI input, tire-scaled */
     double Fc[LCV_MAX_STATES];                           /* the crossfall's constant generalized force */
@@ -65,6 +66,12 @@ typedef struct ModelInstance {
     char msg[1024];                                      /* message of the last warning or error */
 } ModelInstance;
 
+/* names of variables and of the Model Exchange states (for messages) */
+const char *model_variable_name(unsigned vr);
+#define LCV_VARIABLE_NAME(vr) model_variable_name(vr)
+unsigned model_me_state_vr(size_t k);
+#define LCV_ME_STATE_VR_OF(k) model_me_state_vr(k)
+
 /* the model API: 0 on success, 1 success with a warning in c->msg, -1 error in c->msg */
 void model_reset(ModelInstance *c);
 int model_exit_initialization(ModelInstance *c);
@@ -73,6 +80,14 @@ int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, 
 int model_set_real(ModelInstance *c, fmi2ValueReference vr, double value);
 int model_get_string(ModelInstance *c, fmi2ValueReference vr, const char **value);
 int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value);
+/* Model Exchange (SPEC section 15): the continuous states of the interface (v1, r.., theta..,
+   psi1, Y1; 0 for what the vehicle lacks) and their derivatives at the current inputs */
+void model_get_states(ModelInstance *c, double x[], size_t nx);
+void model_set_states(ModelInstance *c, const double x[], size_t nx);
+int model_derivatives(ModelInstance *c, double dx[], size_t nx);
+/* directional derivatives of derivatives and outputs with respect to states and inputs other than u */
+int model_directional(ModelInstance *c, const unsigned unknowns[], size_t nu, const unsigned knowns[], size_t nk,
+                      const double seed[], double out[]);
 /* 0 if a snapshot is acceptable for this instance, else -1 with c->msg */
 int model_check_state(ModelInstance *c, const ModelState *s);
 /* after a snapshot was restored: drop the caches if the vehicle or the tire scale changed */

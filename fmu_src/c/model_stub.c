@@ -50,3 +50,26 @@ int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value)
 int model_check_state(ModelInstance *c, const ModelState *s) { (void)c; (void)s; return 0; }
 
 void model_state_restored(ModelInstance *c, int same_vehicle) { (void)c; (void)same_vehicle; }
+
+void model_get_states(ModelInstance *c, double x[], size_t nx) { (void)c; for (size_t i = 0; i < nx; ++i) x[i] = 0.0; }
+
+void model_set_states(ModelInstance *c, const double x[], size_t nx) { (void)c; (void)x; (void)nx; }
+
+int model_derivatives(ModelInstance *c, double dx[], size_t nx)
+{
+    (void)c;
+    for (size_t i = 0; i < nx; ++i) dx[i] = 0.0;
+    return 0;
+}
+
+const char *model_variable_name(unsigned vr) { (void)vr; return "?"; }
+
+unsigned model_me_state_vr(size_t k) { (void)k; return 0u; }
+
+int model_directional(ModelInstance *c, const unsigned unknowns[], size_t nu, const unsigned knowns[], size_t nk,
+                      const double seed[], double out[])
+{
+    (void)c; (void)unknowns; (void)knowns; (void)nk; (void)seed;
+    for (size_t i = 0; i < nu; ++i) out[i] = 0.0;
+    return 0;
+}

@@ -23,6 +23,7 @@ typedef struct {
     const double *Vth;            /* N x n: the part proportional to u (u K on the theta columns) */
     const double *R;              /* N x n: yaw rates of the units */
     const double *Bc;             /* n: generalized force per unit of sin(atan(crossfall)) (m_i g at the CGs) */
+    const int *me_z;              /* LCV_N_ME_STATES: index in z of each Model Exchange state, -1 if absent */
 } LcvVehicle;
 
 #endif

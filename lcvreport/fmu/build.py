@@ -199,6 +199,9 @@ def config_header(itf: Interface, model_identifier: str, fmu_guid: str) -> str:
         f"#define LCV_N_VEHICLES {len(itf.vehicles)}",
         f"#define LCV_MAX_STATES {size['states']}", f"#define LCV_MAX_UNITS {size['units']}",
         f"#define LCV_MAX_M {size['m']}", f"#define LCV_WORK {size['work']}", "",
+        "/* Model Exchange: continuous states (outputs) and their derivatives (locals after every variable) */",
+        f"#define LCV_N_ME_STATES {len(itf.continuous_states)}",
+        f"#define LCV_FIRST_DERIVATIVE {len(itf.variables)}", "",
         "/* parameters: defaults */",
         f"#define LCV_DEFAULT_PRESET {_c_string(itf.vehicles[0].name)}",
         f"#define LCV_PRESET_LIST {_c_string(', '.join(v.name for v in itf.vehicles))}",
@@ -240,6 +243,8 @@ def config_data_header(itf: Interface) -> str:
         + ", ".join(in_kind[v.source[0]] for v in itf.inputs) + "};",
         "static const int LCV_OUTPUT_KIND[LCV_N_OUTPUTS] = {"
         + ", ".join(out_kind.get(v.source[0], "LCV_OUT_LINEAR") for v in itf.outputs) + "};",
+        "static const unsigned LCV_ME_STATE_VR[LCV_N_ME_STATES] = {"
+        + ", ".join(str(v.value_reference) for v in itf.continuous_states) + "};",
         "", "#endif", ""])
 
 
@@ -270,9 +275,10 @@ def vehicle_data_header(itf: Interface) -> str:
         for name, arr in arrays.items():
             out.append(_c_array("double", f"{p}_{name}", arr))
         out.append(_c_array("int", f"{p}_ay_unit", maps["ay_unit"]))
+        out.append(_c_array("int", f"{p}_me_z", [itf.state_index(sv, v) for sv in itf.continuous_states]))
         entries.append(f"    {{{_c_string(v.name)}, {N}, {n}, " + ", ".join(f"{p}_{a}" for a in (
-            "M0", "M1", "S0", "Sinv", "Su", "Skin", "Bdelta", "Bw", "C", "H", "W", "ay_unit", "Vq", "Vth", "R", "Bc"))
-            + "}")
+            "M0", "M1", "S0", "Sinv", "Su", "Skin", "Bdelta", "Bw", "C", "H", "W", "ay_unit", "Vq", "Vth", "R", "Bc",
+            "me_z")) + "}")
     out.append("static const LcvVehicle LCV_VEHICLES[LCV_N_VEHICLES] = {\n" + ",\n".join(entries) + "\n};")
     out += ["", "#endif", ""]
     return "\n".join(out)
@@ -312,8 +318,9 @@ def loader_config_header(itf: Interface, model_identifier: str, fmu_guid: str, e
 
 
 # ---------------------------------------------------------------------------- compiling and zipping
-def _compile(sources: list[Path], include: list[Path], out: Path, libs: list[str]) -> None:
-    cmd = ["gcc", *CFLAGS, *[f"-I{d}" for d in include], "-o", str(out), *map(str, sources), *libs]
+def _compile(sources: list[Path], include: list[Path], out: Path, libs: list[str], defines=()) -> None:
+    cmd = ["gcc", *CFLAGS, *[f"-D{d}" for d in defines], *[f"-I{d}" for d in include], "-o", str(out),
+           *map(str, sources), *libs]
     try:
         p = subprocess.run(cmd, capture_output=True, text=True)
     except FileNotFoundError:
@@ -373,6 +380,40 @@ def bundled_package_name(fmu_guid: str) -> str:
     """The name the Python FMU bundles lcvreport under: ``lcvreport_fmu_<12 hex digits of its guid>``
     (every internal import is relative, so the package runs under any name)."""
     return "lcvreport_fmu_" + hashlib.sha256(fmu_guid.encode()).hexdigest()[:12]
+
+
+def build_native_fmu3(itf: Interface, out_dir: Path, model_identifier: str) -> Path:
+    """The FMI 3.0 native FMU ``<model_identifier>.fmu`` (Co-Simulation and Model Exchange),
+    from the same model code as the FMI 2.0 one with fmi3_api.c in front (SPEC section 15)."""
+    from .model_description3 import FMI3_SOURCE_FILES, build_description3, model_description3
+    out_dir = Path(out_dir).resolve()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    fmu_guid = guid(itf, model_identifier)
+    src, hdr = source_dir() / "c", fmi_header_dir()
+    generated = {"config.h": config_header(itf, model_identifier, fmu_guid),
+                 "config_data.h": config_data_header(itf), "vehicle_data.h": vehicle_data_header(itf)}
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        for name, text in generated.items():
+            (tmp / name).write_text(text, encoding="utf-8")
+        lib = tmp / f"{model_identifier}.so"
+        _compile([src / s for s in FMI3_SOURCE_FILES], [tmp, src, hdr], lib, ["-lm"], defines=["LCV_FMI3"])
+        files = {"modelDescription.xml": model_description3(itf, model_identifier,
+                                                            generation_tool="lcvreport.fmu.build (C99)"),
+                 f"binaries/x86_64-linux/{model_identifier}.so": lib.read_bytes(),
+                 "sources/buildDescription.xml": build_description3(model_identifier)}
+        for s in FMI3_SOURCE_FILES + C_HEADERS:
+            files[f"sources/{s}"] = (src / s).read_bytes()
+        for name, text in generated.items():
+            files[f"sources/{name}"] = text.encode()
+        if not itf.preset_mode:
+            files["resources/vehicle.toml"] = dumps_vehicle(itf.vehicles[0]).encode()
+        doc = documentation_files(itf, model_identifier, native=True)
+        doc["documentation/index.html"] = doc["documentation/index.html"].replace(b"FMI 2.0 Co-Simulation FMU",
+                                                                                  b"FMI 3.0 Co-Simulation and Model "
+                                                                                  b"Exchange FMU")
+        files.update(doc)
+        return _zip(out_dir / f"{model_identifier}.fmu", files)
 
 
 def _package_copy(dst: Path, name: str = "lcvreport") -> None:
@@ -441,14 +482,16 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
 
 
 def build_preset_fmus(out_dir: Path) -> list[Path]:
-    """``LCV.fmu`` and ``LCVNative.fmu`` (SPEC section 5)."""
+    """``LCV.fmu`` and ``LCVNative.fmu`` (SPEC section 5), and ``LCVNative3.fmu`` (FMI 3.0, SPEC section 15)."""
     itf = preset_interface()
-    return [build_python_fmu(itf, out_dir, "LCV"), build_native_fmu(itf, out_dir, "LCVNative")]
+    return [build_python_fmu(itf, out_dir, "LCV"), build_native_fmu(itf, out_dir, "LCVNative"),
+            build_native_fmu3(itf, out_dir, "LCVNative3")]
 
 
 def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both",
-                       u_start_mps: float = U_START) -> list[Path]:
-    """``<name>.fmu`` (pythonfmu) and/or ``<name>Native.fmu`` (C99) of a vehicle (SPEC section 9).
+                       u_start_mps: float = U_START, fmi: int = 2) -> list[Path]:
+    """``<name>.fmu`` (pythonfmu) and/or ``<name>Native.fmu`` (C99) of a vehicle (SPEC section 9);
+    with ``fmi=3``, ``<name>Native3.fmu`` (FMI 3.0, native only so far).
 
     Parameters
     ----------
@@ -457,10 +500,17 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
     kind : {"python", "native", "both"}
     u_start_mps : float
         Start value of the input ``u`` [m/s] (default 50 mph).
+    fmi : {2, 3}
     """
     if kind not in ("python", "native", "both"):
         raise ValueError(f"kind must be python, native or both, got {kind!r}")
+    if fmi not in (2, 3):
+        raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
     itf = vehicle_interface(vehicle, u_start_mps)
+    if fmi == 3:
+        if kind != "native":
+            raise ValueError("FMI 3.0 FMUs are built native only (the Python FMU is FMI 2.0 so far)")
+        return [build_native_fmu3(itf, Path(out_dir), f"{vehicle.name}Native3")]
     out = []
     if kind in ("python", "both"):
         out.append(build_python_fmu(itf, Path(out_dir), vehicle.name))

@@ -151,6 +151,23 @@ class Interface:
     def parameters(self) -> tuple[FmuVariable, ...]:
         return self.of("parameter")
 
+    @property
+    def continuous_states(self) -> tuple[FmuVariable, ...]:
+        """The Model Exchange states: the outputs v1, r1..rN, the articulation angles, psi1, Y1
+        (SPEC section 15), in value-reference order."""
+        return tuple(v for v in self.outputs if v.source[0] in ("state", "psi1", "Y1"))
+
+    def state_index(self, variable: FmuVariable, vehicle: Vehicle) -> int:
+        """Index of a continuous state in the model's z = [x, psi1, Y1] of ``vehicle``; -1 for a
+        state the vehicle lacks (a preset with fewer units)."""
+        kind = variable.source[0]
+        if kind == "psi1":
+            return vehicle.n_states
+        if kind == "Y1":
+            return vehicle.n_states + 1
+        names = vehicle.state_names
+        return names.index(variable.source[1]) if variable.source[1] in names else -1
+
     def vehicle(self, preset: str | None = None) -> Vehicle:
         """The vehicle of this FMU (in preset mode, the preset named ``preset``)."""
         if not self.preset_mode:

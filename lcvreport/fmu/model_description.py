@@ -17,6 +17,8 @@ from __future__ import annotations
 import hashlib
 import math
 import uuid
+
+import numpy as np
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from ..units import M_PER_FT, M_PER_IN, MPS_PER_MPH, N_PER_LBF, NM_PER_LBF_FT, NM_PER_LBF_IN, S_PER_HOUR
@@ -28,6 +30,7 @@ UNIT_DEFINITIONS = {
     "m": ({"m": 1}, [("in", 1 / M_PER_IN), ("ft", 1 / M_PER_FT), ("mm", 1000.0)]),
     "rad": ({"rad": 1}, [("deg", 180.0 / math.pi)]),
     "rad/s": ({"rad": 1, "s": -1}, [("deg/s", 180.0 / math.pi)]),
+    "rad/s2": ({"rad": 1, "s": -2}, [("deg/s2", 180.0 / math.pi)]),
     "N": ({"kg": 1, "m": 1, "s": -2}, [("lbf", 1 / N_PER_LBF), ("kN", 1e-3)]),
     "N.m": ({"kg": 1, "m": 2, "s": -2}, [("lbf.ft", 1 / NM_PER_LBF_FT), ("lbf.in", 1 / NM_PER_LBF_IN),
                                         ("kN.m", 1e-3)]),
@@ -36,6 +39,8 @@ UNIT_DEFINITIONS = {
     "1": ({}, []),
     "%": ({"factor": 0.01}, []),
 }
+#: the unit of a state's time derivative
+UNIT_DERIVATIVE = {"m/s": "m/s2", "rad": "rad/s", "m": "m/s", "rad/s": "rad/s2"}
 #: log categories of both FMUs
 LOG_CATEGORIES = {
     "logStatusWarning": "Log messages with fmi2Warning status (speed clamped to u_min).",
@@ -50,14 +55,37 @@ DEFAULT_EXPERIMENT = {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.001
 NATIVE_SOURCE_FILES = ("fmi2_api.c", "fmi2_shared.c", "model.c", "linalg.c")
 
 
-def _direct_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
-    """Inputs an output depends on directly (feedthrough)."""
+def _state_dependencies(itf: Interface) -> dict:
+    """Output name -> the continuous states it depends on (Model Exchange), from the engine's
+    output maps of every vehicle of the FMU: linear outputs through C, rear offsets through
+    the relative headings H, lateral accelerations through every state but psi1 and Y1."""
+    from .engine import LCVEngine
+    states = itf.continuous_states
+    deps = {v.name: set() for v in itf.outputs}
+    for vehicle in itf.vehicles:
+        maps = LCVEngine(itf, preset=vehicle.name if itf.preset_mode else None).maps()
+        z_of = {itf.state_index(sv, vehicle): sv.name for sv in states if itf.state_index(sv, vehicle) >= 0}
+        heading_z = {j for j in range(maps["H"].shape[1]) if np.any(maps["H"][:, j] != 0)}
+        for o, v in enumerate(itf.outputs):
+            kind = v.source[0]
+            if kind == "ay":
+                deps[v.name] |= {name for j, name in z_of.items() if j < vehicle.n_states}
+            elif kind == "y":
+                deps[v.name] |= {z_of[j] for j in heading_z if j in z_of and np.any(maps["W"][o] != 0)}
+            elif kind != "max_real_eig":
+                deps[v.name] |= {z_of[j] for j in np.nonzero(maps["C"][o])[0] if j in z_of}
+    return deps
+
+
+def _direct_dependencies(itf: Interface, v: FmuVariable, states: dict | None = None) -> list[str]:
+    """Inputs (feedthrough) and, with ``states``, continuous states an output depends on."""
     kind = v.source[0]
+    out = set((states or {}).get(v.name, ()))
     if kind == "ay":
-        return [w.name for w in itf.inputs]
+        out |= {w.name for w in itf.inputs}
     if kind == "max_real_eig":
-        return ["u"]
-    return []
+        out |= {"u"}
+    return list(out)
 
 
 def _initial_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
@@ -105,18 +133,30 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
         "description": itf.description + ("" if not native else " Native C implementation: no Python at run time."),
         "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": generation_tool,
         "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
+    if native:                  # Model Exchange from the same model code (SPEC section 15)
+        me = SubElement(root, "ModelExchange", {
+            "modelIdentifier": model_identifier, "needsExecutionTool": "false",
+            "completedIntegratorStepNotNeeded": "true", "canBeInstantiatedOnlyOncePerProcess": "false",
+            "canNotUseMemoryManagementFunctions": "true", "canGetAndSetFMUstate": "true",
+            "canSerializeFMUstate": "true", "providesDirectionalDerivative": "true"})
+        files = SubElement(me, "SourceFiles")
+        for name in NATIVE_SOURCE_FILES:
+            SubElement(files, "File", name=name)
     cs = SubElement(root, "CoSimulation", {
         "modelIdentifier": model_identifier, "needsExecutionTool": "false" if native else "true",
         "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
         "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
         "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
         "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
-        "providesDirectionalDerivative": "false"})
+        "providesDirectionalDerivative": "true" if native else "false"})
     if native:                  # the official headers come with the importer (fmpy's c-code), not in sources/
         files = SubElement(cs, "SourceFiles")
         for name in NATIVE_SOURCE_FILES:
             SubElement(files, "File", name=name)
-    used = sorted({v.unit for v in itf.variables if v.unit})
+    used = {v.unit for v in itf.variables if v.unit}
+    if native:                  # the units of the Model Exchange derivatives
+        used |= {UNIT_DERIVATIVE[v.unit] for v in itf.continuous_states if v.unit in UNIT_DERIVATIVE}
+    used = sorted(used)
     defs = SubElement(root, "UnitDefinitions")
     for name in used:
         base, displays = UNIT_DEFINITIONS[name]
@@ -172,14 +212,36 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
             real["start"] = _num(v.start)
         SubElement(sv, "Real", real)
     index = {v.name: v.value_reference + 1 for v in itf.variables}
+    derivatives = []
+    if native:                  # der(x) of every continuous state, locals after every variable
+        for k, sv in enumerate(itf.continuous_states):
+            vr = len(itf.variables) + k
+            name = f"der({sv.name})"
+            derivatives.append(name)
+            index[name] = vr + 1
+            dv = SubElement(mv, "ScalarVariable", {"name": name, "valueReference": str(vr),
+                                                   "description": f"Time derivative of {sv.name}",
+                                                   "causality": "local", "variability": "continuous",
+                                                   "initial": "calculated"})
+            real = {"derivative": str(index[sv.name])}
+            if UNIT_DERIVATIVE.get(sv.unit):
+                real["unit"] = UNIT_DERIVATIVE[sv.unit]
+            SubElement(dv, "Real", real)
+    states = _state_dependencies(itf) if native else None
     ms = SubElement(root, "ModelStructure")
     outs = SubElement(ms, "Outputs")
+    if derivatives:
+        ders = SubElement(ms, "Derivatives")
     init = SubElement(ms, "InitialUnknowns")
     for v in itf.outputs:                  # dependencies in ascending order (FMI 2.0.4, section 2.2.8)
-        deps = " ".join(str(i) for i in sorted(index[n] for n in _direct_dependencies(itf, v)))
+        deps = " ".join(str(i) for i in sorted(index[n] for n in _direct_dependencies(itf, v, states)))
         SubElement(outs, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
+    for name in derivatives:               # every state and input (no dependencies attribute: all)
+        SubElement(ders, "Unknown", {"index": str(index[name])})
     for v in itf.outputs:
         deps = " ".join(str(i) for i in sorted(index[n] for n in _initial_dependencies(itf, v)))
         SubElement(init, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
+    for name in derivatives:
+        SubElement(init, "Unknown", {"index": str(index[name])})
     indent(root)
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + tostring(root, encoding="utf-8") + b"\n"
