@@ -62,7 +62,10 @@ report() {
 }
 
 run_tests() {
-    "$PY" -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider "$@"
+    # one BLAS thread per process: parallelism comes from the two pytest workers (issue 21)
+    local n="${LCV_BLAS_THREADS:-1}"
+    OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-$n}" OMP_NUM_THREADS="${OMP_NUM_THREADS:-$n}" \
+        MKL_NUM_THREADS="${MKL_NUM_THREADS:-$n}" "$PY" -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider "$@"
 }
 
 cmd="${1:-all}"

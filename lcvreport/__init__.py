@@ -12,6 +12,7 @@ Where things live (the folders are the layers; each imports only the ones above 
 ``util/``                helpers with no physics:
     ``cache``            an LRU cache (discretizations, output maps)
     ``numerics``         numpy-only numerics: equilibrated solve, expm
+    ``threads``          one BLAS thread at the entry points (LCV_BLAS_THREADS to change it)
 ``model/``               **the model core** (numpy only):
     ``vehicle``          Axle, Unit, Vehicle (SI parameter sets, validated)
     ``vehicle_file``     vehicle files (TOML, SI): load_vehicle, dumps_vehicle
@@ -28,6 +29,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``exact``            exact response to them (augmented exponential), extrema between samples
     ``field_measures``   RA peak, yaw damping (PBS style), HSTO, HSSO (SPEC 12)
     ``low_speed_turn``   the low-speed 90° turn: swept width, offtracking, tail and frontal swing (SPEC 16)
+    ``driver``           a path-following driver with preview, the closed loop of vehicle and driver
     ``criteria``         the user's limits and the verdicts
     ``tracking``         per-tire conicity and ply steer, fleet statistics of the trimmed offtracking
     ``placement``        which measured tire goes where: the exact mounting plan (a mixed-integer program)
@@ -49,6 +51,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``interface``        the one interface table (SPEC sections 5 and 9)
     ``model_description`` modelDescription.xml from that table
     ``model_description3`` the FMI 3.0 modelDescription.xml and buildDescription.xml
+    ``driver``           the driver FMU (FMI 2.0 CS and ME, C99) of analysis.driver
     ``engine``           the co-simulation engine (numpy only)
     ``slave``            the pythonfmu slave class, a thin map onto the engine
     ``build``            builders of the pythonfmu and the C FMU (sources in the
@@ -59,7 +62,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``reporting``        captions, tables (HTML, LaTeX), CSV of every table and figure
     ``assessment``       what the assessment report of one vehicle shows
     ``build``            papermill + nbconvert: the thesis report, the assessment report
-``cli``                  the ``lcv`` command
+``cli``                  the ``lcv`` command (``_entry``: its console script, one BLAS thread first)
 
 Units
 -----

@@ -24,7 +24,11 @@ other Unix tools.  No output is ever non-finite.
 """
 from __future__ import annotations
 
-import argparse
+if __name__ == "__main__":          # python -m lcvreport.cli: one BLAS thread before numpy loads
+    from lcvreport.util.threads import configure_entry_point
+    configure_entry_point()
+
+import argparse  # noqa: E402
 import errno
 import json
 import math

@@ -26,6 +26,10 @@ stops with one message naming the parameter and what is valid.  Steps of a build
 """
 from __future__ import annotations
 
+if __name__ == "__main__":          # the thesis report: kernels inherit one BLAS thread
+    from lcvreport.util.threads import configure_entry_point
+    configure_entry_point()
+
 import argparse
 import copy
 import shutil
