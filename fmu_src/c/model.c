@@ -267,6 +267,21 @@ static int check_inputs_(ModelInstance *c, int speed)
 
 static int check_inputs(ModelInstance *c) { return check_inputs_(c, 1); }
 
+/* the speed the model runs at (u clamped to u_min); *warn = 1 with the message in c->msg the
+   first time u falls below u_min */
+static double clamped_speed(ModelInstance *c, int *clamped, int *warn)
+{
+    double u_in = c->s.w[0];
+    *clamped = u_in < c->s.u_min;
+    *warn = 0;
+    if (*clamped && !c->s.clamped) {
+        snprintf(c->msg, sizeof c->msg, "u = %.6g m/s is below u_min = %.6g m/s; the model runs at u_min until u "
+                 "rises again (the linear model needs a forward speed)", u_in, c->s.u_min);
+        *warn = 1;
+    }
+    return *clamped ? c->s.u_min : u_in;
+}
+
 int model_do_step(ModelInstance *c, double h)
 {
     if (!(isfinite(h) && h >= LCV_STEP_LOW && h <= LCV_STEP_HIGH)) {
@@ -277,13 +292,8 @@ int model_do_step(ModelInstance *c, double h)
     if (check_inputs(c) != 0) return -1;
     const LcvVehicle *v = vehicle_of(c);
     int m = v->n + 2, ld = m + LCV_N_INPUTS;
-    double u_in = c->s.w[0], u = u_in < c->s.u_min ? c->s.u_min : u_in;
-    int warn = 0, clamped = u_in < c->s.u_min;
-    if (clamped && !c->s.clamped) {
-        snprintf(c->msg, sizeof c->msg, "u = %.6g m/s is below u_min = %.6g m/s; the model runs at u_min until u "
-                 "rises again (the linear model needs a forward speed)", u_in, c->s.u_min);
-        warn = 1;
-    }
+    int clamped, warn;
+    double u = clamped_speed(c, &clamped, &warn);
     const StepEntry *step = step_matrix(c, u, h);
     const double *K = step ? step->K : NULL;
     if (!K) {
@@ -351,13 +361,8 @@ int model_derivatives(ModelInstance *c, double dx[], size_t nx)
     if (!v) return 0;                                  /* before initialization: at rest */
     if (check_inputs(c) != 0) return -1;
     int n = v->n;
-    double u_in = c->s.w[0], u = u_in < c->s.u_min ? c->s.u_min : u_in;
-    int warn = 0, clamped = u_in < c->s.u_min;
-    if (clamped && !c->s.clamped) {
-        snprintf(c->msg, sizeof c->msg, "u = %.6g m/s is below u_min = %.6g m/s; the model runs at u_min until u "
-                 "rises again (the linear model needs a forward speed)", u_in, c->s.u_min);
-        warn = 1;
-    }
+    int clamped, warn;
+    double u = clamped_speed(c, &clamped, &warn);
     c->s.clamped = clamped;
     SpeedEntry *se = speed_entry(c, u);
     if (!se) {

@@ -54,6 +54,8 @@ from .tracking import TireSlot, TrackingError, axle_residuals, sensitivities, ti
 GAP_M = 1e-6
 #: plans within this much of the least |offtracking| [m] count as tied (then: least |trim steer|)
 TIE_M = 1e-6
+#: how much of the tie band is kept back for the solver's tolerances [m]
+FEASIBILITY_M = 5e-7
 #: the rounded plan's offtracking must equal the program's to this [m]
 CHECK_M = 1e-6
 #: random placements drawn for the comparison, and their seed
@@ -325,9 +327,9 @@ def place_tires(vehicle: Vehicle, speed_mps: float, tires: list[dict], positions
         obj = np.concatenate([scale * coef[row], [0.0]])
         c0 = scale * const[row]
         cons += [LinearConstraint(np.vstack([obj - t, obj + t]), [-np.inf, -c0], [-c0, np.inf])]
-        if band is not None:
-            o = np.concatenate([coef[0], [0.0]])
-            cons.append(LinearConstraint(o[None, :], [-band - const[0]], [band - const[0]]))
+        if band is not None:    # in micrometres: HiGHS meets a row in metres only to ~1e-6 m
+            o = np.concatenate([coef[0], [0.0]]) * 1e6
+            cons.append(LinearConstraint(o[None, :], [1e6 * (-band - const[0])], [1e6 * (band - const[0])]))
         integrality = np.ones(nb + 1)
         integrality[nb] = 0
         upper = np.ones(nb + 1)
@@ -342,10 +344,16 @@ def place_tires(vehicle: Vehicle, speed_mps: float, tires: list[dict], positions
             raise TrackingError("the placement program returned a plan that is not an assignment")
         return y, float(res.fun), float(getattr(res, "mip_dual_bound", res.fun))
 
-    y, t_off, bound = solve(0, 1.0, None)
-    # ties: within TIE_M of the least |offtracking|, the least |trim steer| (to GAP_M rad)
+    y, _t_off, bound = solve(0, 1.0, None)
+    # ties: within TIE_M of the least |offtracking|, the least |trim steer| (to GAP_M rad).  The
+    # band is set from the first plan's own offtracking (HiGHS meets rows in metres only to
+    # about 1e-6 m, so its objective may undercut it), narrowed by FEASIBILITY_M, and written
+    # in micrometres; the tie plan is kept only if it keeps the band.
+    o_first = abs(const[0] + coef[0] @ y.ravel())
     try:
-        y = solve(1, 1.0, max(t_off, 0.0) + TIE_M)[0]
+        y2 = solve(1, 1.0, o_first + TIE_M - FEASIBILITY_M)[0]
+        if abs(const[0] + coef[0] @ y2.ravel()) <= o_first + TIE_M:
+            y = y2
     except TrackingError:
         pass                                                      # keep the first plan: it is optimal for O
     order, face = [None] * n, [0.0] * n
@@ -357,7 +365,7 @@ def place_tires(vehicle: Vehicle, speed_mps: float, tires: list[dict], positions
     mounted = _mount(slots, tires, order, face)
     off, dlt = _evaluate(vehicle, speed_mps, mounted, F_const, tire_scale)
     y_vec = y.ravel()
-    if abs(off - (const[0] + coef[0] @ y_vec)) > CHECK_M or abs(off) > t_off + TIE_M + CHECK_M or \
+    if abs(off - (const[0] + coef[0] @ y_vec)) > CHECK_M or abs(off) > o_first + TIE_M + CHECK_M or \
             abs(off) - bound > GAP_M + TIE_M + CHECK_M:
         raise TrackingError(f"the placement program's plan does not check: offtracking {off:.9g} m mounted, "
                             f"{const[0] + coef[0] @ y_vec:.9g} m in the program, lower bound {bound:.9g} m")

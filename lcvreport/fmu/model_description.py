@@ -36,6 +36,7 @@ UNIT_DEFINITIONS = {
                                         ("kN.m", 1e-3)]),
     "m/s2": ({"m": 1, "s": -2}, [("g", 1 / 9.80665)]),
     "1/s": ({"s": -1}, [("1/min", 60.0)]),
+    "s": ({"s": 1}, []),
     "1": ({}, []),
     "%": ({"factor": 0.01}, []),
 }
@@ -75,6 +76,38 @@ def _state_dependencies(itf: Interface) -> dict:
             elif kind != "max_real_eig":
                 deps[v.name] |= {z_of[j] for j in np.nonzero(maps["C"][o])[0] if j in z_of}
     return deps
+
+
+def unit_definitions(root: Element, names) -> Element:
+    """``<UnitDefinitions>`` of the units ``names`` (the same element in FMI 2.0 and 3.0)."""
+    defs = SubElement(root, "UnitDefinitions")
+    for name in sorted(names):
+        base, displays = UNIT_DEFINITIONS[name]
+        unit = SubElement(defs, "Unit", name=name)
+        SubElement(unit, "BaseUnit", {k: str(e) for k, e in base.items()})
+        for dname, factor in displays:
+            SubElement(unit, "DisplayUnit", {"name": dname, "factor": _num(factor)})
+    return defs
+
+
+def declared_types(itf: Interface) -> dict:
+    """(quantity kind, display unit) -> (type name, attributes: quantity, unit, displayUnit) of
+    every real variable's declared type."""
+    from .interface import QUANTITIES
+    out = {}
+    for v in itf.variables:
+        key = (v.quantity, v.display_unit)
+        if v.type != "Real" or v.quantity not in QUANTITIES or key in out:
+            continue
+        name = QUANTITIES[v.quantity] + (f"_{v.display_unit.replace('/', '_per_').replace('.', '_')}"
+                                         if v.display_unit else "")
+        attrs = {"quantity": QUANTITIES[v.quantity]}
+        if v.unit:
+            attrs["unit"] = v.unit
+        if v.display_unit:
+            attrs["displayUnit"] = v.display_unit
+        out[key] = (name, attrs)
+    return out
 
 
 def _direct_dependencies(itf: Interface, v: FmuVariable, states: dict | None = None) -> list[str]:
@@ -127,7 +160,6 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
         True for the C FMU (no execution tool); False for the pythonfmu FMU.
     generation_tool : str
     """
-    from .interface import QUANTITIES
     root = Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": model_identifier, "guid": guid(itf, model_identifier),
         "description": itf.description + ("" if not native else " Native C implementation: no Python at run time."),
@@ -156,30 +188,12 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
     used = {v.unit for v in itf.variables if v.unit}
     if native:                  # the units of the Model Exchange derivatives
         used |= {UNIT_DERIVATIVE[v.unit] for v in itf.continuous_states if v.unit in UNIT_DERIVATIVE}
-    used = sorted(used)
-    defs = SubElement(root, "UnitDefinitions")
-    for name in used:
-        base, displays = UNIT_DEFINITIONS[name]
-        unit = SubElement(defs, "Unit", name=name)
-        SubElement(unit, "BaseUnit", {k: str(e) for k, e in base.items()})
-        for dname, factor in displays:
-            SubElement(unit, "DisplayUnit", {"name": dname, "factor": _num(factor)})
+    unit_definitions(root, used)
     types = SubElement(root, "TypeDefinitions")
-    declared = {}
-    for v in itf.variables:
-        if v.type != "Real" or v.quantity not in QUANTITIES:
-            continue
-        key = (v.quantity, v.display_unit)
-        if key not in declared:
-            name = QUANTITIES[v.quantity] + (f"_{v.display_unit.replace('/', '_per_').replace('.', '_')}"
-                                             if v.display_unit else "")
-            declared[key] = name
-            real = {"quantity": QUANTITIES[v.quantity]}
-            if v.unit:
-                real["unit"] = v.unit
-            if v.display_unit:
-                real["displayUnit"] = v.display_unit
-            SubElement(SubElement(types, "SimpleType", name=name), "Real", real)
+    declared = declared_types(itf)
+    for name, attrs in declared.values():
+        SubElement(SubElement(types, "SimpleType", name=name), "Real", attrs)
+    declared = {key: name for key, (name, _attrs) in declared.items()}
     cats = SubElement(root, "LogCategories")
     for name, text in LOG_CATEGORIES.items():
         SubElement(cats, "Category", name=name, description=text)

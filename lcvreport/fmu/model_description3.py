@@ -17,9 +17,10 @@ from __future__ import annotations
 
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
-from .interface import QUANTITIES, Interface
-from .model_description import (DEFAULT_EXPERIMENT, LOG_CATEGORIES, UNIT_DEFINITIONS, UNIT_DERIVATIVE,
-                                _direct_dependencies, _initial_dependencies, _num, _state_dependencies, guid)
+from .interface import Interface
+from .model_description import (DEFAULT_EXPERIMENT, LOG_CATEGORIES, UNIT_DERIVATIVE, _direct_dependencies,
+                                _initial_dependencies, _num, _state_dependencies, declared_types, guid,
+                                unit_definitions)
 
 #: the C sources of the FMI 3.0 native FMU (built with LCV_FMI3 defined)
 FMI3_SOURCE_FILES = ("fmi3_api.c", "fmi2_shared.c", "model.c", "linalg.c")
@@ -46,28 +47,12 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
         "providesIntermediateUpdate": "false", "providesDirectionalDerivatives": "true"})
     used = {v.unit for v in itf.variables if v.unit}
     used |= {UNIT_DERIVATIVE[v.unit] for v in itf.continuous_states if v.unit in UNIT_DERIVATIVE}
-    used.add("s")
-    defs = SubElement(root, "UnitDefinitions")
-    for name in sorted(used):
-        base, displays = UNIT_DEFINITIONS.get(name, ({"s": 1}, []))
-        unit = SubElement(defs, "Unit", name=name)
-        SubElement(unit, "BaseUnit", {k: str(e) for k, e in base.items()})
-        for dname, factor in displays:
-            SubElement(unit, "DisplayUnit", {"name": dname, "factor": _num(factor)})
+    unit_definitions(root, used | {"s"})
     types = SubElement(root, "TypeDefinitions")
     declared = {}
-    for v in itf.variables:
-        if v.type != "Real" or v.quantity not in QUANTITIES or (v.quantity, v.display_unit) in declared:
-            continue
-        name = QUANTITIES[v.quantity] + (f"_{v.display_unit.replace('/', '_per_').replace('.', '_')}"
-                                         if v.display_unit else "")
-        declared[(v.quantity, v.display_unit)] = name
-        attrs = {"name": name, "quantity": QUANTITIES[v.quantity]}
-        if v.unit:
-            attrs["unit"] = v.unit
-        if v.display_unit:
-            attrs["displayUnit"] = v.display_unit
-        SubElement(types, "Float64Type", attrs)
+    for key, (name, attrs) in declared_types(itf).items():
+        SubElement(types, "Float64Type", {"name": name, **attrs})
+        declared[key] = name
     cats = SubElement(root, "LogCategories")
     for name, text in LOG_CATEGORIES.items():
         SubElement(cats, "Category", name=name, description=text)
