@@ -558,3 +558,18 @@ def test_the_assessment_shows_the_manoeuvres_the_residual_sources_and_the_verdic
                           "21=0.002", "--crossfall-percent", "2", "--json").stdout)
     assert float(measures["trim.offtracking_m"]) == pytest.approx(doc["trim"]["offtracking_m"], rel=1e-12)
     assert float(measures["hsto_m"]) == pytest.approx(doc["hsto_m"], rel=1e-12)
+
+
+def test_a_failed_notebook_is_kept_where_the_message_says(tmp_path):
+    """An assessment report's staging folder is removed when it fails: the executed notebook
+    the message names is a copy outside it, and it exists."""
+    out = tmp_path / "staging"
+    out.mkdir()
+    with pytest.raises(ReportError) as info:
+        execute("assessment", out, {"fast": True, "data_dir": None, "preset": "aucnat", "vehicle_file": None,
+                                    "source": None, "speed_kph": 88.0, "residuals": None,
+                                    "criteria_file": str(tmp_path / "absent.toml"), "load_units": None,
+                                    "tracking": None})
+    kept = Path(re.search(r"executed copy: (\S+\.ipynb)\)", str(info.value)).group(1))
+    assert kept.exists() and out not in kept.parents
+    assert "CriteriaError" in str(info.value)

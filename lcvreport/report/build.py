@@ -267,8 +267,19 @@ def execute(stem: str, out_dir: Path, parameters: dict, source_dir: Path | None 
             raise KeyboardInterrupt from None
         where = _failed_cell(src, dst, exc.cell_index)
         raise ReportError(f"notebook {src.name} failed in {where}: {exc.ename}: {exc.evalue} "
-                          f"(executed copy: {dst})") from None
+                          f"(executed copy: {_keep_failed(dst)})") from None
     return dst
+
+
+def _keep_failed(executed: Path) -> Path:
+    """A copy of a failed executed notebook outside the report being written (an assessment
+    report's staging folder is removed when it fails): a new temporary folder."""
+    import tempfile
+    if not executed.exists():
+        return executed
+    keep = Path(tempfile.mkdtemp(prefix="lcv-failed-notebook-")) / executed.name
+    shutil.copy(executed, keep)
+    return keep
 
 
 def _failed_cell(src: Path, executed: Path, fallback: int) -> str:
