@@ -39,7 +39,6 @@ True
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 import sys
 from dataclasses import dataclass, field
@@ -48,7 +47,7 @@ import numpy as np
 
 from ..model.vehicle import Vehicle
 from .measures import trim
-from .tracking import TireSlot, TrackingError, axle_residuals, sensitivities, tire_slots
+from .tracking import TireSlot, TrackingError, axle_residuals, sensitivities, tire_number, tire_slots
 
 #: optimality of the plan's |offtracking| [m] (HiGHS's absolute MIP gap, objective in m)
 GAP_M = 1e-6
@@ -167,13 +166,7 @@ def read_measured_tires(path) -> list[dict]:
                 if key in COLUMNS:
                     raise TrackingError(f"{path}: line {k}: tire {tid}: {key} is empty")
                 continue
-            try:
-                val = float(raw)
-            except ValueError:
-                raise TrackingError(f"{path}: line {k}: tire {tid}: {key} must be a number, got {raw!r}") from None
-            if not math.isfinite(val) or abs(val) > 1e6:
-                raise TrackingError(f"{path}: line {k}: tire {tid}: {key} must be finite and within 1e6, got {raw!r}")
-            tire[key] = val
+            tire[key] = tire_number(raw, f"{path}: line {k}: tire {tid}: {key}")
         tires.append(tire)
     if not tires:
         raise TrackingError(f"{path}: no tires")

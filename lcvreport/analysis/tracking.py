@@ -214,6 +214,17 @@ TIRE_COLUMNS = ("position", "conicity_N", "ply_steer_N", "serial_side")
 TIRE_OPTIONAL = ("id", "conicity_moment_Nm", "ply_steer_moment_Nm")
 
 
+def tire_number(raw, where: str) -> float:
+    """A tire file's number: finite and within 1e6 (N or N*m), else a TrackingError naming ``where``."""
+    try:
+        val = float(raw)
+    except (TypeError, ValueError):
+        raise TrackingError(f"{where} must be a number, got {raw!r}") from None
+    if not math.isfinite(val) or abs(val) > 1e6:
+        raise TrackingError(f"{where} must be finite and within 1e6, got {raw!r}")
+    return val
+
+
 def read_mounted_tires(path) -> list[dict]:
     """Mounted tires from a CSV (header ``position,conicity_N,ply_steer_N,serial_side``
     and optionally ``id``, ``conicity_moment_Nm``, ``ply_steer_moment_Nm``) or a TOML file
@@ -260,13 +271,7 @@ def read_mounted_tires(path) -> list[dict]:
             raise TrackingError(f"{path}: tire {k}: serial_side must be out or in, got {tire['serial_side']!r}")
         for key in ("conicity_N", "ply_steer_N", "conicity_moment_Nm", "ply_steer_moment_Nm"):
             if key in row and row[key] not in (None, ""):
-                try:
-                    val = float(row[key])
-                except (TypeError, ValueError):
-                    raise TrackingError(f"{path}: tire {k}: {key} must be a number, got {row[key]!r}") from None
-                if not math.isfinite(val) or abs(val) > 1e6:
-                    raise TrackingError(f"{path}: tire {k}: {key} must be finite and within 1e6, got {row[key]!r}")
-                tire[key] = val
+                tire[key] = tire_number(row[key], f"{path}: tire {k}: {key}")
         out.append(tire)
     if not out:
         raise TrackingError(f"{path}: no tires")

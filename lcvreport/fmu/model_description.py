@@ -90,6 +90,18 @@ def unit_definitions(root: Element, names) -> Element:
     return defs
 
 
+def variable_attributes(v: FmuVariable) -> dict:
+    """name, value reference, description, causality, variability and initial of a variable
+    (the same attributes in FMI 2.0 and 3.0)."""
+    attrs = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
+             "causality": v.causality, "variability": v.variability}
+    if v.causality == "output":
+        attrs["initial"] = "calculated"
+    elif v.causality == "parameter":
+        attrs["initial"] = "exact"
+    return attrs
+
+
 def declared_types(itf: Interface) -> dict:
     """(quantity kind, display unit) -> (type name, attributes: quantity, unit, displayUnit) of
     every real variable's declared type."""
@@ -200,13 +212,7 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
     SubElement(root, "DefaultExperiment", DEFAULT_EXPERIMENT)
     mv = SubElement(root, "ModelVariables")
     for v in itf.variables:
-        attrs = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
-                 "causality": v.causality, "variability": v.variability}
-        if v.causality == "output":
-            attrs["initial"] = "calculated"
-        elif v.causality == "parameter":
-            attrs["initial"] = "exact"
-        sv = SubElement(mv, "ScalarVariable", attrs)
+        sv = SubElement(mv, "ScalarVariable", variable_attributes(v))
         if v.type == "String":
             SubElement(sv, "String", {"start": str(v.start)})
             continue

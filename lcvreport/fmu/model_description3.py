@@ -20,7 +20,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 from .interface import Interface
 from .model_description import (DEFAULT_EXPERIMENT, LOG_CATEGORIES, UNIT_DERIVATIVE, _direct_dependencies,
                                 _initial_dependencies, _num, _state_dependencies, declared_types, guid,
-                                unit_definitions)
+                                unit_definitions, variable_attributes)
 
 #: the C sources of the FMI 3.0 native FMU (built with LCV_FMI3 defined)
 FMI3_SOURCE_FILES = ("fmi3_api.c", "fmi2_shared.c", "model.c", "linalg.c")
@@ -62,12 +62,7 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
     SubElement(mv, "Float64", {"name": "time", "valueReference": str(t_vr), "causality": "independent",
                                "variability": "continuous", "unit": "s", "description": "Simulation time"})
     for v in itf.variables:
-        attrs = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
-                 "causality": v.causality, "variability": v.variability}
-        if v.causality == "output":
-            attrs["initial"] = "calculated"
-        elif v.causality == "parameter":
-            attrs["initial"] = "exact"
+        attrs = variable_attributes(v)
         if v.type == "String":
             SubElement(SubElement(mv, "String", attrs), "Start", value=str(v.start))
             continue
