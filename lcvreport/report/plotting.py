@@ -778,7 +778,12 @@ def fig_tracking_sensitivity(answer) -> Figure:
     ax2.set_xlabel("scale on the assumed population [-]")
     ax2.set_ylabel("log10 P(|offtracking| > lane margin) [-]")
     ax2.grid(True, lw=0.3)
-    ax2.legend(fontsize=SMALL_PT)
+    floor = -40.0                       # the smallest scales' closed form (e.g. 10^-2181) would squash the rest
+    if min(r["log10_p_exceed_gaussian"] for r in rows) < floor:
+        ax2.set_ylim(floor, 1.0)
+        ax2.text(0.98, 0.72, "below 10^-40: off the axis (see the table)", transform=ax2.transAxes, ha="right",
+                 va="top", fontsize=SMALL_PT)
+    ax2.legend(fontsize=SMALL_PT, loc="lower left")
     fig.suptitle("aucnat at 50 mph: the assumed tire population scaled", fontsize=9)
     fig.lcv_data = rows
     return fig
