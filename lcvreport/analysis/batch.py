@@ -1,0 +1,134 @@
+"""Variants of one vehicle in a batch: masses, yaw inertias and tire coefficients as arrays,
+the model's matrices and the damping measures batched over the leading axis (SPEC section 14,
+issue 21; first part).
+
+Every coefficient of the model (M0, M1, S0, Sinv, Su, Skin, B_delta) is affine in each unit's
+mass and yaw inertia and in each axle's per-tire C_F, C_M and C_S (positions held): the batch
+is the nominal coefficients plus, for every varied parameter, its change times the
+coefficients' derivative, which is exact (a difference of two builds at the nominal and at
+twice the nominal value).  No Python loop runs per variant; one runs per varied parameter.
+
+Parameter names: ``<unit>.mass_kg``, ``<unit>.yaw_inertia_kg_m2``,
+``<axle>.cornering_stiffness_N_per_rad``, ``<axle>.aligning_stiffness_Nm_per_rad``,
+``<axle>.longitudinal_stiffness_N`` (unit and axle names of the vehicle).
+
+Examples
+--------
+>>> import numpy as np
+>>> from lcvreport import load_preset
+>>> v = load_preset("aucnat")
+>>> b = VariantBatch(v, {"trailer3.mass_kg": v.units[5].mass_kg * np.array([0.8, 1.0, 1.2])})
+>>> zeta, f_hz = b.least_damping(24.0)
+>>> zeta.shape
+(3,)
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..model.builder import system_coefficients
+from ..model.vehicle import Vehicle
+from ..util.numerics import solve_scaled
+
+#: the coefficients the batch varies, and the parameters it can vary
+COEFFICIENTS = ("M0", "M1", "S0", "Sinv", "Su", "Skin", "Bdelta")
+UNIT_PARAMETERS = ("mass_kg", "yaw_inertia_kg_m2")
+AXLE_PARAMETERS = ("cornering_stiffness_N_per_rad", "aligning_stiffness_Nm_per_rad", "longitudinal_stiffness_N")
+
+
+class BatchError(ValueError):
+    """An unknown parameter, arrays of different lengths, a value that is not positive and finite."""
+
+
+def _with(vehicle: Vehicle, name: str, value: float) -> Vehicle:
+    owner, _, key = name.partition(".")
+    units = list(vehicle.units)
+    for i, u in enumerate(units):
+        if key in UNIT_PARAMETERS and u.name == owner:
+            units[i] = replace(u, **{key: value})
+            return replace(vehicle, units=tuple(units))
+        if key in AXLE_PARAMETERS:
+            for j, a in enumerate(u.axles):
+                if a.name == owner:
+                    axles = list(u.axles)
+                    axles[j] = replace(a, **{key: value})
+                    units[i] = replace(u, axles=tuple(axles))
+                    return replace(vehicle, units=tuple(units))
+    valid = [f"{u.name}.{k}" for u in vehicle.units for k in UNIT_PARAMETERS] + \
+        [f"{a.name}.{k}" for a in vehicle.axles for k in AXLE_PARAMETERS]
+    raise BatchError(f"unknown parameter {name!r}; valid: {', '.join(valid)}")
+
+
+def _nominal(vehicle: Vehicle, name: str) -> float:
+    owner, _, key = name.partition(".")
+    for u in vehicle.units:
+        if key in UNIT_PARAMETERS and u.name == owner:
+            return float(getattr(u, key))
+        for a in u.axles:
+            if key in AXLE_PARAMETERS and a.name == owner:
+                return float(getattr(a, key))
+    _with(vehicle, name, 0.0)                     # raises with the valid names
+    raise AssertionError  # pragma: no cover
+
+
+@dataclass
+class VariantBatch:
+    """``B`` variants of ``vehicle``: ``values`` maps parameter names to arrays of shape (B,) (SI)."""
+
+    vehicle: Vehicle
+    values: dict
+    coefficients: dict = field(init=False, repr=False)
+
+    def __post_init__(self):
+        lengths = {np.shape(v) for v in self.values.values()}
+        if len(lengths) > 1 or any(len(s) != 1 for s in lengths):
+            raise BatchError(f"every parameter needs an array of one length, got shapes {sorted(lengths)}")
+        base = system_coefficients(self.vehicle)
+        B = next(iter(lengths))[0] if lengths else 1
+        coeffs = {k: np.broadcast_to(getattr(base, k), (B,) + getattr(base, k).shape).copy() for k in COEFFICIENTS}
+        for name, arr in self.values.items():
+            arr = np.asarray(arr, dtype=float)
+            if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+                raise BatchError(f"{name}: every value must be finite and > 0")
+            p0 = _nominal(self.vehicle, name)
+            step = p0 if p0 > 0 else 1.0
+            bumped = system_coefficients(_with(self.vehicle, name, p0 + step))
+            for k in COEFFICIENTS:
+                d = (getattr(bumped, k) - getattr(base, k)) / step
+                coeffs[k] += (arr - p0).reshape((B,) + (1,) * d.ndim) * d
+        self.coefficients = coeffs
+
+    @property
+    def size(self) -> int:
+        return self.coefficients["M0"].shape[0]
+
+    def state_matrix(self, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+        """A = M^-1 S of every variant at ``speed_mps`` [m/s], shape (B, 2N, 2N)."""
+        c = self.coefficients
+        u = float(speed_mps)
+        M = c["M0"] + u * c["M1"]
+        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        return solve_scaled(M, S)
+
+    def eigenvalues(self, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+        """Eigenvalues [1/s] of every variant, shape (B, 2N) (unordered)."""
+        return np.linalg.eigvals(self.state_matrix(speed_mps, tire_scale))
+
+    def least_damping(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """(least damping ratio [-], its damped frequency [Hz]) of every variant over the oscillatory
+        modes, as :func:`lcvreport.analysis.measures.least_damping` (NaN where none oscillates)."""
+        lam = self.eigenvalues(speed_mps, tire_scale)
+        osc = lam.imag > 1e-12 * np.maximum(np.abs(lam).max(axis=-1, keepdims=True), 1.0)
+        zeta = np.where(osc, -lam.real / np.where(np.abs(lam) > 0, np.abs(lam), 1.0), np.inf)
+        k = np.argmin(zeta, axis=-1)
+        rows = np.arange(lam.shape[0])
+        best = zeta[rows, k]
+        f_hz = lam[rows, k].imag / (2 * np.pi)
+        none = ~np.isfinite(best)
+        return np.where(none, np.nan, best), np.where(none, np.nan, f_hz)
+
+    def max_real(self, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+        """Largest real part of the eigenvalues of every variant [1/s] (negative: stable)."""
+        return self.eigenvalues(speed_mps, tire_scale).real.max(axis=-1)

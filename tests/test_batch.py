@@ -1,0 +1,49 @@
+"""Variants in a batch (issue 21, first part): the batched matrices and damping measures equal
+the one-variant calls on random batches to 1e-12 relative."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lcvreport import load_preset, load_vehicle
+from lcvreport.analysis.batch import AXLE_PARAMETERS, UNIT_PARAMETERS, BatchError, VariantBatch, _nominal, _with
+from lcvreport.analysis.measures import least_damping
+from lcvreport.analysis.modes import eigenvalues, state_matrix
+
+from conftest import EXAMPLES
+
+
+@pytest.mark.parametrize("source", ["aucnat", "b_double"])
+def test_batched_measures_equal_one_variant_calls(source):
+    v = load_preset(source) if source == "aucnat" else load_vehicle(EXAMPLES / f"{source}.toml")
+    names = [f"{u.name}.{k}" for u in v.units for k in UNIT_PARAMETERS] + \
+        [f"{a.name}.{k}" for a in v.axles for k in AXLE_PARAMETERS]
+    names = [n for n in names if _nominal(v, n) > 0]          # C_S of a steer axle is 0
+    rng = np.random.default_rng(21)
+    B = 12
+    values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, B) for n in names}
+    batch = VariantBatch(v, values)
+    u = 24.0
+    A = batch.state_matrix(u)
+    zeta, f_hz = batch.least_damping(u)
+    top = batch.max_real(u)
+    for i in range(B):
+        vi = v
+        for n, arr in values.items():
+            vi = _with(vi, n, float(arr[i]))
+        Ai = state_matrix(vi, u)
+        assert np.abs(A[i] - Ai).max() <= 1e-12 * np.abs(Ai).max()
+        z1, f1 = least_damping(vi, u)
+        assert zeta[i] == pytest.approx(z1, rel=1e-12) and f_hz[i] == pytest.approx(f1, rel=1e-12)
+        assert top[i] == pytest.approx(eigenvalues(vi, u).real.max(), rel=1e-12, abs=1e-14)
+    assert np.ptp(zeta) > 0                                    # the variants do differ
+
+
+def test_bad_batches_are_refused():
+    v = load_preset("tractor_semitrailer")
+    with pytest.raises(BatchError, match="unknown parameter 'trailer9.mass_kg'"):
+        VariantBatch(v, {"trailer9.mass_kg": np.ones(2)})
+    with pytest.raises(BatchError, match="one length"):
+        VariantBatch(v, {"tractor.mass_kg": np.ones(2) * 1e4, "trailer1.mass_kg": np.ones(3) * 1e4})
+    with pytest.raises(BatchError, match="finite and > 0"):
+        VariantBatch(v, {"tractor.mass_kg": np.array([1e4, np.nan])})
