@@ -47,3 +47,25 @@ def test_bad_batches_are_refused():
         VariantBatch(v, {"tractor.mass_kg": np.ones(2) * 1e4, "trailer1.mass_kg": np.ones(3) * 1e4})
     with pytest.raises(BatchError, match="finite and > 0"):
         VariantBatch(v, {"tractor.mass_kg": np.array([1e4, np.nan])})
+
+
+@pytest.mark.parametrize("tire_scale", [0.2, 1.0])
+def test_batched_critical_speed_equals_the_one_variant_algorithm(tire_scale):
+    """Masses and C_F varied ±40 % on the empty triple: unstable and stable variants alike,
+    the same critical speed (to its 0.1 km/h) as measures.critical_speed of each variant."""
+    from lcvreport.analysis.measures import critical_speed
+    v = load_preset("empty")
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(14)
+    B = 16
+    values = {n: _nominal(v, n) * rng.uniform(0.6, 1.4, B) for n in names}
+    got = VariantBatch(v, values).critical_speed(tire_scale=tire_scale)
+    ref = []
+    for i in range(B):
+        vi = v
+        for n, arr in values.items():
+            vi = _with(vi, n, float(arr[i]))
+        r = critical_speed(vi, tire_scale=tire_scale)
+        ref.append(np.nan if r is None else r)
+    assert np.array_equal(np.nan_to_num(got, nan=-1.0), np.nan_to_num(np.array(ref), nan=-1.0)), (got, ref)
+    assert np.isfinite(got).any()

@@ -24,6 +24,7 @@ Examples
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -132,3 +133,77 @@ class VariantBatch:
     def max_real(self, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
         """Largest real part of the eigenvalues of every variant [1/s] (negative: stable)."""
         return self.eigenvalues(speed_mps, tire_scale).real.max(axis=-1)
+
+    def _max_real_at(self, v_kph: np.ndarray, tire_scale: float) -> np.ndarray:
+        """max Re(lambda) of variant b at speed v_kph[b, j] [km/h], shape like v_kph (B, J)."""
+        from ..units import kph_to_mps
+        c = self.coefficients
+        u = kph_to_mps(np.asarray(v_kph, dtype=float))[..., None, None]          # (B, J, 1, 1)
+        M = c["M0"][:, None] + u * c["M1"][:, None]
+        S = tire_scale * (c["S0"][:, None] + c["Sinv"][:, None] / u) + c["Skin"][:, None] + u * c["Su"][:, None]
+        return np.linalg.eigvals(solve_scaled(M, S)).real.max(axis=-1)
+
+    def critical_speed(self, tire_scale: float = 1.0, u_min_mps: float | None = None,
+                       u_max_kph: float | None = None) -> np.ndarray:
+        """The critical speed [km/h] of every variant (NaN: stable up to ``u_max_kph``), by the
+        algorithm of :func:`lcvreport.analysis.measures.critical_speed` run on all variants at
+        once: the coarse 4 km/h scan, the 1 km/h scan of each variant's own doubtful intervals,
+        the bisection to 0.01 km/h, rounded to 0.1 km/h."""
+        from ..analysis.measures import CRITICAL_SPEED_MAX_KPH, U_MIN_DEFAULT_MPS
+        from ..ranges import RANGES
+        from ..units import mps_to_kph
+        u_max_kph = CRITICAL_SPEED_MAX_KPH if u_max_kph is None else u_max_kph
+        lo_kph = mps_to_kph(RANGES["u_min"].check(U_MIN_DEFAULT_MPS if u_min_mps is None else u_min_mps, "u_min"))
+        B = self.size
+        coarse = np.linspace(lo_kph, u_max_kph, max(int(math.ceil((u_max_kph - lo_kph) / 4.0)) + 1, 2))
+        sigma = self._max_real_at(np.broadcast_to(coarse, (B, coarse.size)), tire_scale)     # (B, K)
+        step = np.abs(np.diff(sigma, axis=1))
+        padded = np.concatenate([step[:, :1], step, step[:, -1:]], axis=1)
+        slope = np.maximum(np.maximum(padded[:, :-2], padded[:, 1:-1]), padded[:, 2:])
+        near = np.maximum(sigma[:, :-1], sigma[:, 1:]) > -2.0 * slope                      # (B, K-1)
+        # the fine points of every interval; a variant evaluates only those of its own doubtful ones
+        fine_of = [np.linspace(coarse[i], coarse[i + 1], int(math.ceil(coarse[i + 1] - coarse[i])) + 1)[1:-1]
+                   for i in range(coarse.size - 1)]
+        fine = np.concatenate(fine_of)
+        owner = np.concatenate([np.full(f.size, i) for i, f in enumerate(fine_of)])
+        use = near[:, owner]                                                                # (B, F)
+        fine_vals = np.full(use.shape, -np.inf)
+        rows, cols = np.nonzero(use)
+        if rows.size:
+            fine_vals[rows, cols] = self._values_at(rows, fine[cols], tire_scale)
+        grid = np.concatenate([coarse, fine])
+        order = np.argsort(grid, kind="stable")
+        grid = grid[order]
+        values = np.concatenate([sigma, fine_vals], axis=1)[:, order]
+        present = np.concatenate([np.ones((B, coarse.size), bool), use], axis=1)[:, order]
+        flags = (values >= 0.0) & present
+        out = np.full(B, np.nan)
+        found = flags.any(axis=1)
+        first = np.argmax(flags, axis=1)
+        at_start = found & (first == 0)
+        out[at_start] = np.round(grid[0], 1)
+        todo = np.flatnonzero(found & (first > 0))
+        if todo.size:
+            # the previous evaluated grid point of each variant
+            idx = np.arange(grid.size)
+            prev = np.array([idx[present[b] & (idx < first[b])].max() for b in todo])
+            lo, hi = grid[prev].astype(float), grid[first[todo]].astype(float)
+            active = hi - lo > 0.01
+            while active.any():
+                mid = 0.5 * (lo + hi)
+                m = np.flatnonzero(active)
+                unstable = self._values_at(todo[m], mid[m], tire_scale) >= 0.0
+                hi[m] = np.where(unstable, mid[m], hi[m])
+                lo[m] = np.where(unstable, lo[m], mid[m])
+                active = hi - lo > 0.01
+            out[todo] = np.round(0.5 * (lo + hi), 1)
+        return out
+
+    def _values_at(self, variants: np.ndarray, v_kph: np.ndarray, tire_scale: float) -> np.ndarray:
+        """max Re(lambda) of variant ``variants[k]`` at ``v_kph[k]`` [km/h], shape (K,)."""
+        from ..units import kph_to_mps
+        c = self.coefficients
+        u = kph_to_mps(np.asarray(v_kph, dtype=float))[:, None, None]
+        M = c["M0"][variants] + u * c["M1"][variants]
+        S = tire_scale * (c["S0"][variants] + c["Sinv"][variants] / u) + c["Skin"][variants] + u * c["Su"][variants]
+        return np.linalg.eigvals(solve_scaled(M, S)).real.max(axis=-1)
