@@ -69,3 +69,22 @@ def test_batched_critical_speed_equals_the_one_variant_algorithm(tire_scale):
         ref.append(np.nan if r is None else r)
     assert np.array_equal(np.nan_to_num(got, nan=-1.0), np.nan_to_num(np.array(ref), nan=-1.0)), (got, ref)
     assert np.isfinite(got).any()
+
+
+def test_batched_gains_and_rearward_amplification():
+    from lcvreport.analysis.measures import rearward_amplification, steer_to_acceleration
+    v = load_preset("aucnat")
+    names = [f"{u.name}.yaw_inertia_kg_m2" for u in v.units] + [f"{a.name}.aligning_stiffness_Nm_per_rad"
+                                                                 for a in v.axles]
+    rng = np.random.default_rng(5)
+    values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 8) for n in names}
+    batch = VariantBatch(v, values)
+    G = batch.steer_to_acceleration(24.0, 0.4, tire_scale=0.9)
+    ra = batch.rearward_amplification(24.0, 0.4, tire_scale=0.9)
+    for i in range(8):
+        vi = v
+        for n, arr in values.items():
+            vi = _with(vi, n, float(arr[i]))
+        Gi = steer_to_acceleration(vi, 24.0, 0.4, tire_scale=0.9)
+        assert np.abs(G[i] - Gi).max() <= 1e-12 * np.abs(Gi).max()
+        assert ra[i] == pytest.approx(rearward_amplification(vi, 24.0, 0.4, tire_scale=0.9), rel=1e-12)

@@ -134,6 +134,26 @@ class VariantBatch:
         """Largest real part of the eigenvalues of every variant [1/s] (negative: stable)."""
         return self.eigenvalues(speed_mps, tire_scale).real.max(axis=-1)
 
+    def steer_to_acceleration(self, speed_mps: float, f_hz: float, tire_scale: float = 1.0) -> np.ndarray:
+        """G_i(j 2 pi f): gain from the steer angle to every unit's CG lateral acceleration
+        [m/s^2 per rad] of every variant, shape (B, N), as
+        :func:`lcvreport.analysis.measures.steer_to_acceleration` (the velocity and yaw-rate
+        maps depend on the geometry only, which the batch does not vary)."""
+        co = system_coefficients(self.vehicle)
+        c = self.coefficients
+        u = float(speed_mps)
+        M = c["M0"] + u * c["M1"]
+        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        b = tire_scale * c["Bdelta"]
+        w = 2 * np.pi * float(f_hz)
+        x = np.linalg.solve(1j * w * M - S, b[..., None])[..., 0]
+        return x @ co.velocity_map(u).T * (1j * w) + u * (x @ co.yaw_rate_map().T)
+
+    def rearward_amplification(self, speed_mps: float, f_hz: float, tire_scale: float = 1.0) -> np.ndarray:
+        """RA(f) = |G_N| / |G_1| [-] of every variant, shape (B,)."""
+        G = np.abs(self.steer_to_acceleration(speed_mps, f_hz, tire_scale))
+        return G[:, -1] / G[:, 0]
+
     def _max_real_at(self, v_kph: np.ndarray, tire_scale: float) -> np.ndarray:
         """max Re(lambda) of variant b at speed v_kph[b, j] [km/h], shape like v_kph (B, J)."""
         from ..units import kph_to_mps
