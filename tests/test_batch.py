@@ -88,3 +88,23 @@ def test_batched_gains_and_rearward_amplification():
         Gi = steer_to_acceleration(vi, 24.0, 0.4, tire_scale=0.9)
         assert np.abs(G[i] - Gi).max() <= 1e-12 * np.abs(Gi).max()
         assert ra[i] == pytest.approx(rearward_amplification(vi, 24.0, 0.4, tire_scale=0.9), rel=1e-12)
+
+
+def test_batched_trim_equals_the_one_variant_trim():
+    """Residual forces and moments on the last two trailers (1 % rule), C_F and masses varied."""
+    from lcvreport.analysis.measures import trim
+    from lcvreport.model.loads import load_vector, one_percent_rule
+    v = load_preset("aucnat")
+    F = load_vector(v, one_percent_rule(v, ["trailer2", "trailer3"]))
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(9)
+    values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 10) for n in names}
+    delta, off = VariantBatch(v, values).trim(24.0, F, tire_scale=0.8)
+    for i in range(10):
+        vi = v
+        for n, arr in values.items():
+            vi = _with(vi, n, float(arr[i]))
+        t = trim(vi, 24.0, F, tire_scale=0.8)
+        assert delta[i] == pytest.approx(t.delta_rad, rel=1e-12)
+        assert off[i] == pytest.approx(t.offtracking_m, rel=1e-12)
+    assert np.ptp(off) > 0

@@ -154,6 +154,33 @@ class VariantBatch:
         G = np.abs(self.steer_to_acceleration(speed_mps, f_hz, tire_scale))
         return G[:, -1] / G[:, 0]
 
+    def trim(self, speed_mps: float, F, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """(trim steer [rad], trimmed offtracking [m]) of every variant under the generalized
+        force ``F`` (SI; shape (2N,) for all or (B, 2N)), as :func:`lcvreport.analysis.measures.trim`.
+        F is taken as given: residual P and T map to it through the geometry alone, but a
+        crossfall's m g depends on the masses the batch varies -- build its F per variant."""
+        from .geometry import point_lateral_map, point_longitudinal
+        from .measures import reference_points
+        c = self.coefficients
+        u = float(speed_mps)
+        n = c["M0"].shape[-1]
+        B = self.size
+        K = np.zeros((B, n + 1, n + 1))
+        K[:, :n, :n] = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        K[:, :n, n] = tire_scale * c["Bdelta"]
+        K[:, n, 1] = 1.0
+        rhs = np.zeros((B, n + 1))
+        rhs[:, :n] = -np.broadcast_to(np.asarray(F, dtype=float), (B, n))
+        sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+        x, delta = sol[:, :n], sol[:, n]
+        v = self.vehicle
+        (uq, xq), (up, xp) = reference_points(v)
+        nu = v.n_units
+        Theta = np.cumsum(x[:, nu + 1:], axis=1)
+        lateral = lambda unit, xx: Theta @ point_lateral_map(v, unit, xx)[2:]  # noqa: E731 (psi1 = Y1 = 0)
+        dX = point_longitudinal(v, up, xp) - point_longitudinal(v, uq, xq)
+        return delta, lateral(up, xp) - lateral(uq, xq) - dX * x[:, 0] / u
+
     def _max_real_at(self, v_kph: np.ndarray, tire_scale: float) -> np.ndarray:
         """max Re(lambda) of variant b at speed v_kph[b, j] [km/h], shape like v_kph (B, J)."""
         from ..units import kph_to_mps
