@@ -108,3 +108,19 @@ def test_batched_trim_equals_the_one_variant_trim():
         assert delta[i] == pytest.approx(t.delta_rad, rel=1e-12)
         assert off[i] == pytest.approx(t.offtracking_m, rel=1e-12)
     assert np.ptp(off) > 0
+
+
+def test_batched_steady_turn_equals_hsso():
+    from lcvreport.analysis.field_measures import steady_turn
+    v = load_vehicle(EXAMPLES / "western_double.toml")
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(11)
+    values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 6) for n in names}
+    hsso, delta = VariantBatch(v, values).steady_turn(24.0)
+    for i in range(6):
+        vi = v
+        for n, arr in values.items():
+            vi = _with(vi, n, float(arr[i]))
+        t = steady_turn(vi, 24.0)
+        # hsso is the difference of two ~393 m radii: rounding of 1e-16 of a radius is 1.3e-12 of a 30 mm hsso
+        assert hsso[i] == pytest.approx(t.hsso_m, rel=1e-11) and delta[i] == pytest.approx(t.delta_rad, rel=1e-12)

@@ -161,8 +161,20 @@ class VariantBatch:
         crossfall's m g depends on the masses the batch varies -- build its F per variant."""
         from .geometry import point_lateral_map, point_longitudinal
         from .measures import reference_points
-        c = self.coefficients
         u = float(speed_mps)
+        x, delta = self._steady(u, F, 0.0, tire_scale)
+        v = self.vehicle
+        (uq, xq), (up, xp) = reference_points(v)
+        nu = v.n_units
+        Theta = np.cumsum(x[:, nu + 1:], axis=1)
+        lateral = lambda unit, xx: Theta @ point_lateral_map(v, unit, xx)[2:]  # noqa: E731 (psi1 = Y1 = 0)
+        dX = point_longitudinal(v, up, xp) - point_longitudinal(v, uq, xq)
+        return delta, lateral(up, xp) - lateral(uq, xq) - dX * x[:, 0] / u
+
+    def _steady(self, u: float, F, r1: float, tire_scale: float) -> tuple[np.ndarray, np.ndarray]:
+        """S x + b delta + F = 0 with x[1] = r1 for every variant, as
+        :func:`lcvreport.analysis.measures.steady_with_yaw_rate`: (x (B, 2N), delta (B,))."""
+        c = self.coefficients
         n = c["M0"].shape[-1]
         B = self.size
         K = np.zeros((B, n + 1, n + 1))
@@ -171,15 +183,25 @@ class VariantBatch:
         K[:, n, 1] = 1.0
         rhs = np.zeros((B, n + 1))
         rhs[:, :n] = -np.broadcast_to(np.asarray(F, dtype=float), (B, n))
+        rhs[:, n] = r1
         sol = np.linalg.solve(K, rhs[..., None])[..., 0]
-        x, delta = sol[:, :n], sol[:, n]
+        return sol[:, :n], sol[:, n]
+
+    def steady_turn(self, speed_mps: float, tire_scale: float = 1.0, radius_m: float | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+        """(hsso_m, steer [rad]) of every variant in the steady turn of
+        :func:`lcvreport.analysis.field_measures.steady_turn` (tractor yaw rate u/R)."""
+        from .field_measures import HSSO_RADIUS_M
+        R = HSSO_RADIUS_M if radius_m is None else float(radius_m)
+        u = float(speed_mps)
+        omega = u / R
         v = self.vehicle
-        (uq, xq), (up, xp) = reference_points(v)
-        nu = v.n_units
-        Theta = np.cumsum(x[:, nu + 1:], axis=1)
-        lateral = lambda unit, xx: Theta @ point_lateral_map(v, unit, xx)[2:]  # noqa: E731 (psi1 = Y1 = 0)
-        dX = point_longitudinal(v, up, xp) - point_longitudinal(v, uq, xq)
-        return delta, lateral(up, xp) - lateral(uq, xq) - dX * x[:, 0] / u
+        x, delta = self._steady(u, np.zeros(v.n_states), omega, tire_scale)
+        vel = x @ system_coefficients(v).velocity_map(u).T                 # (B, N) CG lateral velocities
+        steered = max(v.steered_axles, key=lambda a: a.x_m)
+        rear = v.units[-1].rearmost_axle
+        radius = lambda unit, xp: np.hypot(xp + vel[:, unit] / omega, u / omega)  # noqa: E731
+        return radius(v.n_units - 1, rear.x_m) - radius(0, steered.x_m), delta
 
     def _max_real_at(self, v_kph: np.ndarray, tire_scale: float) -> np.ndarray:
         """max Re(lambda) of variant b at speed v_kph[b, j] [km/h], shape like v_kph (B, J)."""
