@@ -124,3 +124,20 @@ def test_batched_steady_turn_equals_hsso():
         t = steady_turn(vi, 24.0)
         # hsso is the difference of two ~393 m radii: rounding of 1e-16 of a radius is 1.3e-12 of a 30 mm hsso
         assert hsso[i] == pytest.approx(t.hsso_m, rel=1e-11) and delta[i] == pytest.approx(t.delta_rad, rel=1e-12)
+
+
+def test_batched_ra_peak_equals_the_one_variant_peak():
+    """The value to 1e-12; where it is to 1e-6 (a smooth maximum is located by comparing values
+    only to about sqrt(eps) of its frequency, by Brent's method and by the golden section alike)."""
+    from lcvreport.analysis.field_measures import ra_peak
+    v = load_preset("aucnat")
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(2)
+    values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 6) for n in names}
+    peak, where = VariantBatch(v, values).ra_peak(24.0)
+    for i in range(6):
+        vi = v
+        for n, arr in values.items():
+            vi = _with(vi, n, float(arr[i]))
+        p = ra_peak(vi, 24.0)
+        assert peak[i] == pytest.approx(p.value, rel=1e-12) and where[i] == pytest.approx(p.frequency_hz, rel=1e-6)

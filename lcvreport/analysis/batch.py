@@ -171,6 +171,51 @@ class VariantBatch:
         dX = point_longitudinal(v, up, xp) - point_longitudinal(v, uq, xq)
         return delta, lateral(up, xp) - lateral(uq, xq) - dX * x[:, 0] / u
 
+    def _ra_at(self, speed_mps: float, f_hz: np.ndarray, tire_scale: float, rows=None) -> np.ndarray:
+        """RA of variant rows[b] (default: every variant) at frequency f_hz[b, j] [Hz], shape (K, J)."""
+        co = system_coefficients(self.vehicle)
+        c = {k: (v if rows is None else v[rows]) for k, v in self.coefficients.items()}
+        u = float(speed_mps)
+        M = (c["M0"] + u * c["M1"])[:, None]
+        S = (tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"])[:, None]
+        b = np.broadcast_to((tire_scale * c["Bdelta"])[:, None], f_hz.shape + c["Bdelta"].shape[-1:])
+        w = (2 * np.pi * f_hz)[..., None, None]
+        x = np.linalg.solve(1j * w * M - S, b[..., None])[..., 0]
+        G = np.abs(x @ co.velocity_map(u).T * (1j * w[..., 0]) + u * (x @ co.yaw_rate_map().T))
+        return G[..., -1] / G[..., 0]
+
+    def ra_peak(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """(max RA(f) over 0.1-2 Hz [-], where [Hz]) of every variant: the 0.005 Hz scan of
+        :func:`lcvreport.analysis.field_measures.ra_peak`, then a golden-section search of every
+        variant's best bracket at once, to 1e-12 Hz (the one-variant version uses Brent's method)."""
+        from .field_measures import RA_BAND_HZ
+        lo, hi = RA_BAND_HZ
+        f = np.linspace(lo, hi, 381)
+        B = self.size
+        values = self._ra_at(speed_mps, np.broadcast_to(f, (B, f.size)), tire_scale)
+        k = np.argmax(values, axis=1)
+        best, where = values[np.arange(B), k].copy(), f[k].astype(float)
+        idx = np.flatnonzero((k > 0) & (k < f.size - 1))
+        if idx.size:
+            ra = lambda x: self._ra_at(speed_mps, x[:, None], tire_scale, idx)[:, 0]  # noqa: E731
+            g = (math.sqrt(5.0) - 1.0) / 2.0
+            a, c = f[k[idx] - 1].astype(float), f[k[idx] + 1].astype(float)
+            x1, x2 = c - g * (c - a), a + g * (c - a)
+            f1, f2 = ra(x1), ra(x2)
+            while np.max(c - a) > 1e-12:
+                left = f1 > f2                                 # the maximum is in [a, x2], else in [x1, c]
+                a, c = np.where(left, a, x1), np.where(left, x2, c)
+                new = np.where(left, c - g * (c - a), a + g * (c - a))
+                f_new = ra(new)
+                x1, x2 = np.where(left, new, x2), np.where(left, x1, new)
+                f1, f2 = np.where(left, f_new, f2), np.where(left, f1, f_new)
+            xm = np.clip(0.5 * (a + c), lo, hi)
+            vm = ra(xm)
+            better = vm >= best[idx]
+            best[idx] = np.where(better, vm, best[idx])
+            where[idx] = np.where(better, xm, where[idx])
+        return best, where
+
     def _steady(self, u: float, F, r1: float, tire_scale: float) -> tuple[np.ndarray, np.ndarray]:
         """S x + b delta + F = 0 with x[1] = r1 for every variant, as
         :func:`lcvreport.analysis.measures.steady_with_yaw_rate`: (x (B, 2N), delta (B,))."""
