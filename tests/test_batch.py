@@ -141,3 +141,17 @@ def test_batched_ra_peak_equals_the_one_variant_peak():
             vi = _with(vi, n, float(arr[i]))
         p = ra_peak(vi, 24.0)
         assert peak[i] == pytest.approx(p.value, rel=1e-12) and where[i] == pytest.approx(p.frequency_hz, rel=1e-6)
+
+
+def test_the_measures_table_has_the_measure_set_numbers():
+    from lcvreport import measure_set
+    v = load_preset("tractor_semitrailer")
+    values = {"trailer1.mass_kg": _nominal(v, "trailer1.mass_kg") * np.array([0.9, 1.0, 1.1])}
+    table = VariantBatch(v, values).measures(24.0)
+    assert list(table["case_id"]) == [0, 1, 2] and "trailer1.mass_kg" in table
+    m = measure_set(v, 24.0).to_dict()                              # the middle case is the vehicle itself
+    for key in ("least_damping_ratio", "least_damped_frequency_hz", "ra_frequency", "ra_peak", "hsso_m",
+                "steady_turn_delta_rad"):
+        assert table[key][1] == pytest.approx(m[key], rel=1e-11), key
+    assert (np.isnan(table["critical_speed_kph"][1]) and m["critical_speed_kph"] is None) or \
+        table["critical_speed_kph"][1] == m["critical_speed_kph"]

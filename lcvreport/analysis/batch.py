@@ -321,3 +321,25 @@ class VariantBatch:
         M = c["M0"][variants] + u * c["M1"][variants]
         S = tire_scale * (c["S0"][variants] + c["Sinv"][variants] / u) + c["Skin"][variants] + u * c["Su"][variants]
         return np.linalg.eigvals(solve_scaled(M, S)).real.max(axis=-1)
+
+    def measures(self, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None, F=None):
+        """The batched measures of every variant as columns (a dict of arrays of length B, ready
+        for ``pandas.DataFrame``): a ``case_id``, one column per varied parameter and the measures
+        under the keys of ``lcv measures --json`` (``trim_delta_rad``, ``trim_offtracking_m`` with
+        ``F``); NaN where a measure is undefined (no oscillatory mode, stable to 200 km/h)."""
+        from .measures import RA_FREQUENCY_HZ
+        f_hz = RA_FREQUENCY_HZ if f_hz is None else f_hz
+        zeta, f_zeta = self.least_damping(speed_mps, tire_scale)
+        crit = self.critical_speed(tire_scale)
+        peak, peak_f = self.ra_peak(speed_mps, tire_scale)
+        hsso, turn_delta = self.steady_turn(speed_mps, tire_scale)
+        table = {"case_id": np.arange(self.size)}
+        table.update({name: np.asarray(arr, dtype=float) for name, arr in self.values.items()})
+        table.update({"speed_mps": np.full(self.size, float(speed_mps)), "least_damping_ratio": zeta,
+                      "least_damped_frequency_hz": f_zeta, "critical_speed_kph": crit,
+                      "ra_frequency": self.rearward_amplification(speed_mps, f_hz, tire_scale),
+                      "ra_peak": peak, "ra_peak_frequency_hz": peak_f, "hsso_m": hsso,
+                      "steady_turn_delta_rad": turn_delta})
+        if F is not None:
+            table["trim_delta_rad"], table["trim_offtracking_m"] = self.trim(speed_mps, F, tire_scale)
+        return table
