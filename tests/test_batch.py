@@ -13,6 +13,13 @@ from lcvreport.analysis.modes import eigenvalues, state_matrix
 from conftest import EXAMPLES
 
 
+def _variant(v, values: dict, i: int):
+    """Variant ``i`` of ``v`` built one parameter at a time (the one-variant reference)."""
+    for name, arr in values.items():
+        v = _with(v, name, float(arr[i]))
+    return v
+
+
 @pytest.mark.parametrize("source", ["aucnat", "b_double"])
 def test_batched_measures_equal_one_variant_calls(source):
     v = load_preset(source) if source == "aucnat" else load_vehicle(EXAMPLES / f"{source}.toml")
@@ -28,9 +35,7 @@ def test_batched_measures_equal_one_variant_calls(source):
     zeta, f_hz = batch.least_damping(u)
     top = batch.max_real(u)
     for i in range(B):
-        vi = v
-        for n, arr in values.items():
-            vi = _with(vi, n, float(arr[i]))
+        vi = _variant(v, values, i)
         Ai = state_matrix(vi, u)
         assert np.abs(A[i] - Ai).max() <= 1e-12 * np.abs(Ai).max()
         z1, f1 = least_damping(vi, u)
@@ -62,9 +67,7 @@ def test_batched_critical_speed_equals_the_one_variant_algorithm(tire_scale):
     got = VariantBatch(v, values).critical_speed(tire_scale=tire_scale)
     ref = []
     for i in range(B):
-        vi = v
-        for n, arr in values.items():
-            vi = _with(vi, n, float(arr[i]))
+        vi = _variant(v, values, i)
         r = critical_speed(vi, tire_scale=tire_scale)
         ref.append(np.nan if r is None else r)
     assert np.array_equal(np.nan_to_num(got, nan=-1.0), np.nan_to_num(np.array(ref), nan=-1.0)), (got, ref)
@@ -82,9 +85,7 @@ def test_batched_gains_and_rearward_amplification():
     G = batch.steer_to_acceleration(24.0, 0.4, tire_scale=0.9)
     ra = batch.rearward_amplification(24.0, 0.4, tire_scale=0.9)
     for i in range(8):
-        vi = v
-        for n, arr in values.items():
-            vi = _with(vi, n, float(arr[i]))
+        vi = _variant(v, values, i)
         Gi = steer_to_acceleration(vi, 24.0, 0.4, tire_scale=0.9)
         assert np.abs(G[i] - Gi).max() <= 1e-12 * np.abs(Gi).max()
         assert ra[i] == pytest.approx(rearward_amplification(vi, 24.0, 0.4, tire_scale=0.9), rel=1e-12)
@@ -101,9 +102,7 @@ def test_batched_trim_equals_the_one_variant_trim():
     values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 10) for n in names}
     delta, off = VariantBatch(v, values).trim(24.0, F, tire_scale=0.8)
     for i in range(10):
-        vi = v
-        for n, arr in values.items():
-            vi = _with(vi, n, float(arr[i]))
+        vi = _variant(v, values, i)
         t = trim(vi, 24.0, F, tire_scale=0.8)
         assert delta[i] == pytest.approx(t.delta_rad, rel=1e-12)
         assert off[i] == pytest.approx(t.offtracking_m, rel=1e-12)
@@ -118,9 +117,7 @@ def test_batched_steady_turn_equals_hsso():
     values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 6) for n in names}
     hsso, delta = VariantBatch(v, values).steady_turn(24.0)
     for i in range(6):
-        vi = v
-        for n, arr in values.items():
-            vi = _with(vi, n, float(arr[i]))
+        vi = _variant(v, values, i)
         t = steady_turn(vi, 24.0)
         # hsso is the difference of two ~393 m radii: rounding of 1e-16 of a radius is 1.3e-12 of a 30 mm hsso
         assert hsso[i] == pytest.approx(t.hsso_m, rel=1e-11) and delta[i] == pytest.approx(t.delta_rad, rel=1e-12)
@@ -136,9 +133,7 @@ def test_batched_ra_peak_equals_the_one_variant_peak():
     values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 6) for n in names}
     peak, where = VariantBatch(v, values).ra_peak(24.0)
     for i in range(6):
-        vi = v
-        for n, arr in values.items():
-            vi = _with(vi, n, float(arr[i]))
+        vi = _variant(v, values, i)
         p = ra_peak(vi, 24.0)
         assert peak[i] == pytest.approx(p.value, rel=1e-12) and where[i] == pytest.approx(p.frequency_hz, rel=1e-6)
 
