@@ -59,11 +59,11 @@ def stock_slave_source() -> str:
     variability, start values), nothing computed: written from the interface table's
     names only, with pythonfmu's stock getters and setters."""
     from lcvreport.fmu.interface import preset_interface
-    lines = ["from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real, String", "",
+    lines = ["from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real", "",
              "", "class LCV(Fmi2Slave):", "    def __init__(self, **kwargs):", "        super().__init__(**kwargs)"]
     for v in preset_interface().variables:
-        kind = "String" if v.type == "String" else "Real"
-        start = repr(v.start) if v.start is not None else "0.0"
+        kind = "Integer" if v.type == "Enumeration" else "Real"
+        start = ("1" if v.type == "Enumeration" else repr(v.start)) if v.start is not None else "0.0"
         lines.append(f"        self.{v.name} = {start}")
         lines.append(f"        self.register_variable({kind}({v.name!r}, causality=Fmi2Causality.{v.causality}, "
                      f"variability=Fmi2Variability.{v.variability}))")

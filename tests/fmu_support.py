@@ -73,8 +73,10 @@ class Slave:
         self.fmu.setupExperiment(startTime=0.0)
         self.fmu.enterInitializationMode()
         for k, v in start.items():
-            if isinstance(v, str):
+            if isinstance(v, str):               # preset by name: the String path FMUs keep accepting
                 self.fmu.setString([self.vr[k]], [v])
+            elif isinstance(v, int) and not isinstance(v, bool):   # preset, the Enumeration
+                self.fmu.setInteger([self.vr[k]], [v])
             else:
                 self.fmu.setReal([self.vr[k]], [float(v)])
 

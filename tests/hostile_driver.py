@@ -57,7 +57,13 @@ def main(path: str, case: str) -> None:
     elif case == "tire_scale_nan":
         start = {"tire_scale": float("nan")}
     s = Slave(path, **start)
-    if case in ("bad_preset", "tire_scale_huge", "tire_scale_tiny", "u_min_huge", "tire_scale_nan"):
+    if case in ("set_integer_range_0", "set_integer_range_7", "set_integer_real"):     # preset: 1 to 6
+        vr, value = ([s.vr["tire_scale"]], [2]) if case == "set_integer_real" else ([s.vr["preset"]], [int(case[-1])])
+        call(s.fmu.setInteger, vr, value)
+        call(s.fmu.exitInitializationMode)                           # the start value stays: aucnat
+        step(s)
+        read(s)
+    elif case in ("bad_preset", "tire_scale_huge", "tire_scale_tiny", "u_min_huge", "tire_scale_nan"):
         call(s.fmu.exitInitializationMode)
         step(s)
         read(s)
@@ -127,7 +133,9 @@ def main(path: str, case: str) -> None:
         elif case == "fixed_parameter_after_init":
             call(s.fmu.setReal, [s.vr["tire_scale"]], [2.0])
         elif case == "get_integer":
-            call(s.fmu.getInteger, [0])
+            call(s.fmu.getInteger, [1])                   # tire_scale: a Real
+        elif case == "set_integer_after_init":
+            call(s.fmu.setInteger, [0], [2])
         else:
             raise SystemExit(f"unknown case {case}")
     messages = s.log.messages(1)

@@ -15,6 +15,7 @@ from fmpy.fmi2 import FMU2Model, FMU2Slave
 
 from lcvreport.analysis.driver import DEFAULT, PreviewDriver, closed_loop
 from lcvreport.fmu.driver import build_driver_fmu
+from lcvreport.fmu.interface import preset_value
 from lcvreport.model.presets import load_preset
 
 from conftest import TOOLS
@@ -59,7 +60,7 @@ def test_the_driver_fmu_has_working_start_values(driver_fmu, tmp_path):
 
 def _init(m, vr, preset=True):
     if preset:
-        m.setString([vr["preset"]], [PRESET])
+        m.setInteger([vr["preset"]], [preset_value(PRESET)])
     m.setupExperiment(startTime=0.0)
     m.enterInitializationMode()
     m.exitInitializationMode()

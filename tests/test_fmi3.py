@@ -17,7 +17,7 @@ import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi3 import FMU3Model, FMU3Slave, fmi3LogMessageCallback
 
-from lcvreport.fmu.interface import preset_interface
+from lcvreport.fmu.interface import preset_interface, preset_value
 from lcvreport.model.presets import PRESETS
 
 from conftest import BUILD, EXAMPLE_NAMES, EXAMPLES, ROOT, TOOLS
@@ -65,7 +65,7 @@ def _slave(fmu, log, preset=None, logging=True):
     s.instantiate(loggingOn=logging, logMessage=log.callback)
     vr = {v.name: v.valueReference for v in md.modelVariables}
     if preset:
-        s.setString([vr["preset"]], [preset])
+        s.setInt64([vr["preset"]], [preset_value(preset)])
     return s, vr, md
 
 
@@ -121,7 +121,7 @@ def test_model_exchange_with_cvode_and_fmusim(native3_fmu, example3_fmus, tmp_pa
         outs = [v.name for v in itf.outputs]
         names = outs[:outs.index("Y_rear") + 1]
         ref = reference_outputs(itf, [(H, inputs)] + [(H, {})] * (N - 1), preset)
-        start = dict(inputs, **({"preset": preset} if preset else {}))
+        start = dict(inputs, **({"preset": preset_value(preset)} if preset else {}))
         res = simulate_fmu(str(fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
                            stop_time=N * H, output_interval=H, start_values=start, output=names)
         got = np.array([[res[n][k] for n in names] for k in range(1, N + 1)])
@@ -137,7 +137,7 @@ def test_model_exchange_with_cvode_and_fmusim(native3_fmu, example3_fmus, tmp_pa
                     "--stop-time", str(N * H), "--output-interval", str(H), "--input-file", str(tmp_path / "in.csv"),
                     "--output-file", str(tmp_path / "out.csv")]
             if preset:
-                args += ["--start-value", "preset", preset]
+                args += ["--start-value", "preset", str(preset_value(preset))]
             p = subprocess.run(args + [str(fmu)], capture_output=True, text=True, env=host_env(), timeout=300)
             assert p.returncode == 0, (fmu.name, kind, (p.stdout + p.stderr)[-2000:])
             with open(tmp_path / "out.csv") as f:
@@ -218,3 +218,36 @@ def test_hostile_fmi3_calls_are_errors_with_a_message(native3_fmu, logging):
     with pytest.raises(Exception):
         m.instantiate(logMessage=log2.callback)
     assert any("instantiation token mismatch" in msg for msg in log2.errors())
+
+
+def test_preset_is_an_enumeration_in_fmi3(native3_fmu):
+    """SPEC section 15: ``<EnumerationType name="Preset">`` with the presets as items 1..6, the
+    variable an ``<Enumeration>`` starting at 1; fmi3SetInt64/GetInt64 pick and read it, a value
+    outside 1..6 is refused with the range named; the name through fmi3SetString still works."""
+    import xml.etree.ElementTree as ET
+    root = ET.fromstring(zipfile.ZipFile(native3_fmu).read("modelDescription.xml"))
+    enum = root.find("TypeDefinitions/EnumerationType[@name='Preset']")
+    assert [(i.get("name"), int(i.get("value"))) for i in enum] == [(p, k) for k, p in enumerate(PRESETS, 1)]
+    var = root.find("ModelVariables/Enumeration[@name='preset']")
+    assert var.get("declaredType") == "Preset" and var.get("start") == "1" and var.get("causality") == "parameter"
+    for value, expect_error in ((0, True), (7, True), (6, False)):
+        log = Log()
+        s, vr, _md = _slave(native3_fmu, log)
+        with (pytest.raises(Exception) if expect_error else _nullcontext()):
+            s.setInt64([vr["preset"]], [value])
+        if expect_error:
+            assert any(f"preset: {value} is not a preset; valid: 1 to 6" in m for m in log.errors()), log.errors()
+            assert s.getInt64([vr["preset"]]) == [1]
+        else:
+            assert s.getInt64([vr["preset"]]) == [6] and s.getString([vr["preset"]]) == ["tractor_semitrailer"]
+        s.freeInstance()
+    log = Log()
+    s, vr, _md = _slave(native3_fmu, log)
+    s.setString([vr["preset"]], ["legal_max"])
+    assert s.getInt64([vr["preset"]]) == [2]
+    s.freeInstance()
+
+
+def _nullcontext():
+    import contextlib
+    return contextlib.nullcontext()

@@ -46,7 +46,11 @@ CASES = {
     "state_of_another_fmu": ([ERROR, 0], "not written by this FMU"),
     "exit_init_twice": ([0, ERROR], "ExitInitializationMode"),
     "fixed_parameter_after_init": ([ERROR], "tire_scale is a fixed parameter"),
-    "get_integer": ([ERROR], "no Integer variables"),
+    "get_integer": ([ERROR], "not the value reference of an Enumeration variable"),
+    "set_integer_real": ([ERROR, 0, 0, 0], "not the value reference of an Enumeration variable"),
+    "set_integer_range_0": ([ERROR, 0, 0, 0], "preset: 0 is not a preset; valid: 1 to 6"),
+    "set_integer_range_7": ([ERROR, 0, 0, 0], "preset: 7 is not a preset; valid: 1 to 6"),
+    "set_integer_after_init": ([ERROR], "fmi2SetInteger must not be called in phase StepComplete"),
 }
 
 
@@ -68,17 +72,27 @@ def test_hostile_call_in_fmpy(preset_fmu, western_fmus, case):
     assert doc["finite"]
 
 
-def test_a_bad_preset_makes_simulate_fmu_raise(preset_fmu):
-    """Not two rows of zeros: fmpy raises on the error status of initialization."""
-    with pytest.raises(Exception, match="fmi2ExitInitializationMode|status"):
-        simulate_fmu(str(preset_fmu), start_values={"preset": "AUCNAT"}, stop_time=1.0, step_size=0.01)
+@pytest.mark.parametrize("value", [0, 7, -1])
+def test_a_bad_preset_makes_simulate_fmu_raise(preset_fmu, value):
+    """Not two rows of zeros: fmpy raises on the error status of fmi2SetInteger (preset is an
+    Enumeration of 1 to 6)."""
+    with pytest.raises(Exception, match="fmi2SetInteger|status"):
+        simulate_fmu(str(preset_fmu), start_values={"preset": value}, stop_time=1.0, step_size=0.01)
+
+
+@pytest.mark.parametrize("value", [1, 6])
+def test_every_preset_value_runs_in_simulate_fmu(preset_fmu, value):
+    """The Enumeration's ends pick aucnat and tractor_semitrailer (3 and 2 units: y4 is 0 only for the latter)."""
+    res = simulate_fmu(str(preset_fmu), start_values={"preset": value, "delta": 0.01}, stop_time=0.5,
+                       step_size=0.01, output=["y2", "y4"])
+    assert res["y2"][-1] != 0.0 and ((res["y4"][-1] != 0.0) == (value == 1))
 
 
 def test_a_nan_input_makes_simulate_fmu_raise(preset_fmu):
     """Not a silently truncated result."""
     signal = np.array([(0.0, 100.0), (0.5, np.nan)], dtype=[("time", float), ("P61", float)])
     with pytest.raises(Exception, match="fmi2DoStep|status"):
-        simulate_fmu(str(preset_fmu), start_values={"preset": "aucnat"}, stop_time=1.0, step_size=0.01, input=signal)
+        simulate_fmu(str(preset_fmu), start_values={"preset": 1}, stop_time=1.0, step_size=0.01, input=signal)
 
 
 # ---------------------------------------------------------------------------- the C host

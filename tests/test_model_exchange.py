@@ -18,6 +18,7 @@ from fmpy.fmi3 import FMU3Model
 from conftest import TOOLS
 from fmu_support import LogCapture, host_env, interface_of
 from helpers import group_error, reference_outputs
+from lcvreport.fmu.interface import preset_value
 
 FMUSIM = TOOLS / "fmusim"
 H = 0.05
@@ -47,7 +48,7 @@ def _names(itf):
 def _run(fmu, preset, inputs, **kw):
     itf = interface_of(fmu)
     names = _names(itf)
-    start = dict(inputs, **({"preset": preset} if preset else {}))
+    start = dict(inputs, **({"preset": preset_value(preset)} if preset else {}))
     res = simulate_fmu(str(fmu), fmi_type="ModelExchange", stop_time=N * H, start_values=start, output=names, **kw)
     return itf, names, res
 
@@ -97,7 +98,7 @@ def test_fmusim_model_exchange_with_no_ld_preload(native, tmp_path):
             "--output-interval", str(H), "--input-file", str(tmp_path / "in.csv"), "--output-file",
             str(tmp_path / "out.csv")]
     if preset:
-        args += ["--start-value", "preset", preset]
+        args += ["--start-value", "preset", str(preset_value(preset))]
     p = subprocess.run(args + [str(fmu)], capture_output=True, text=True, env=host_env(), timeout=300)
     assert p.returncode == 0, (p.stdout + p.stderr)[-3000:]
     with open(tmp_path / "out.csv") as f:
@@ -213,7 +214,7 @@ def test_directional_derivatives_are_the_models_matrices(native_fmu, which):
     if which == "fmi2":
         me = _ME(native_fmu)
         m = me.m
-        m.setString([vr["preset"]], [preset])
+        m.setInteger([vr["preset"]], [preset_value(preset)])
         me.init()
         m.setReal([vr["u"]], [u])
         dd = m.dll.fmi2GetDirectionalDerivative
@@ -234,7 +235,7 @@ def test_directional_derivatives_are_the_models_matrices(native_fmu, which):
         m = FMU3Model(guid=md.guid, unzipDirectory=extract(str(fmu3)), modelIdentifier="LCVNative3",
                       instanceName="dd3")
         m.instantiate()
-        m.setString([vr["preset"]], [preset])
+        m.setInt64([vr["preset"]], [preset_value(preset)])
         m.enterInitializationMode()
         m.exitInitializationMode()
         m.setFloat64([vr["u"]], [u])

@@ -42,6 +42,8 @@
 #define MASK_fmi2CompletedIntegratorStep PhaseContinuousTimeMode
 #define MASK_fmi2SetString (PhaseInstantiated | PhaseInitializationMode)
 #define MASK_fmi2GetString ANY_PHASE
+#define MASK_fmi2SetInteger (PhaseInstantiated | PhaseInitializationMode)
+#define MASK_fmi2GetInteger ANY_PHASE
 
 static void logmsg(ModelInstance *c, fmi2Status status, const char *fmt, ...)
 {
@@ -245,16 +247,37 @@ static fmi2Status no_variables(fmi2Component comp, size_t nvr, const char *funct
     return fmi2Error;
 }
 
+/* Integer access: the Enumeration preset (SPEC section 15) */
 fmi2Status fmi2GetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[])
 {
-    (void)vr; (void)value;
-    return no_variables(comp, nvr, "fmi2GetInteger", "Integer");
+    BEGIN_FUNCTION(GetInteger)
+    if (nvr == 0) return fmi2OK;
+    if (!vr || !value) { logmsg(c, fmi2Error, "fmi2GetInteger: null array"); return fmi2Error; }
+    fmi2Status status = fmi2OK;
+    for (size_t i = 0; i < nvr; ++i) {
+        int v = 0;
+        if (model_get_integer(c, vr[i], &v) != 0) {
+            logmsg(c, fmi2Error, "fmi2GetInteger: %s", c->msg);
+            status = fmi2Error;
+        }
+        value[i] = v;
+    }
+    return status;
 }
 
 fmi2Status fmi2SetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[])
 {
-    (void)vr; (void)value;
-    return no_variables(comp, nvr, "fmi2SetInteger", "Integer");
+    BEGIN_FUNCTION(SetInteger)
+    if (nvr == 0) return fmi2OK;
+    if (!vr || !value) { logmsg(c, fmi2Error, "fmi2SetInteger: null array"); return fmi2Error; }
+    fmi2Status status = fmi2OK;
+    for (size_t i = 0; i < nvr; ++i) {
+        if (model_set_integer(c, vr[i], value[i]) != 0) {
+            logmsg(c, fmi2Error, "fmi2SetInteger: %s", c->msg);
+            status = fmi2Error;
+        }
+    }
+    return status;
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[])

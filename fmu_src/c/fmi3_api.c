@@ -264,6 +264,38 @@ fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference valueRe
     return status;
 }
 
+/* Int64 access: the Enumeration preset (FMI 3.0 section 2.4.7.4: enumerations through fmi3Get/SetInt64) */
+fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
+                        fmi3Int64 values[], size_t nValues)
+{
+    BEGIN(fmi3GetInt64, ANY_PHASE)
+    if (!scalar_args(c, "fmi3GetInt64", valueReferences, nValueReferences, values, nValues)) return fmi3Error;
+    fmi3Status status = fmi3OK;
+    for (size_t i = 0; i < nValueReferences; ++i) {
+        int v = 0;
+        if (model_get_integer(&c->m, valueReferences[i], &v) != 0) {
+            logmsg(c, fmi3Error, "fmi3GetInt64: %s", c->m.msg);
+            status = fmi3Error;
+        }
+        values[i] = v;
+    }
+    return status;
+}
+
+fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
+                        const fmi3Int64 values[], size_t nValues)
+{
+    BEGIN(fmi3SetInt64, PhaseInstantiated | PhaseInitializationMode)
+    if (!scalar_args(c, "fmi3SetInt64", valueReferences, nValueReferences, values, nValues)) return fmi3Error;
+    fmi3Status status = fmi3OK;
+    for (size_t i = 0; i < nValueReferences; ++i)
+        if (model_set_integer(&c->m, valueReferences[i], (long long)values[i]) != 0) {
+            logmsg(c, fmi3Error, "fmi3SetInt64: %s", c->m.msg);
+            status = fmi3Error;
+        }
+    return status;
+}
+
 static fmi3Status no_variables(fmi3Instance instance, size_t nvr, const char *function, const char *type)
 {
     Instance3 *c = (Instance3 *)instance;
@@ -290,7 +322,6 @@ NO_GET(Int16, fmi3Int16) NO_SET(Int16, fmi3Int16)
 NO_GET(UInt16, fmi3UInt16) NO_SET(UInt16, fmi3UInt16)
 NO_GET(Int32, fmi3Int32) NO_SET(Int32, fmi3Int32)
 NO_GET(UInt32, fmi3UInt32) NO_SET(UInt32, fmi3UInt32)
-NO_GET(Int64, fmi3Int64) NO_SET(Int64, fmi3Int64)
 NO_GET(UInt64, fmi3UInt64) NO_SET(UInt64, fmi3UInt64)
 NO_GET(Boolean, fmi3Boolean) NO_SET(Boolean, fmi3Boolean)
 

@@ -56,7 +56,7 @@
 #define FORWARDED(X) \
     X(fmi2Instantiate) X(fmi2FreeInstance) X(fmi2SetupExperiment) \
     X(fmi2EnterInitializationMode) X(fmi2ExitInitializationMode) X(fmi2Terminate) X(fmi2Reset) \
-    X(fmi2GetReal) X(fmi2GetString) X(fmi2SetReal) X(fmi2SetString) X(fmi2GetFMUstate) X(fmi2SetFMUstate) \
+    X(fmi2GetReal) X(fmi2GetString) X(fmi2SetReal) X(fmi2SetString) X(fmi2GetInteger) X(fmi2SetInteger) X(fmi2GetFMUstate) X(fmi2SetFMUstate) \
     X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize) X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate) \
     X(fmi2DoStep) X(fmi2GetRealStatus)
 
@@ -90,6 +90,8 @@ static void release_pythonfmu(void)
 #define MASK_fmi2SetReal (PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete)
 #define MASK_fmi2SetString (PhaseInstantiated | PhaseInitializationMode)
 #define MASK_fmi2GetString ANY_PHASE
+#define MASK_fmi2SetInteger (PhaseInstantiated | PhaseInitializationMode)
+#define MASK_fmi2GetInteger ANY_PHASE
 #define MASK_fmi2Reset ANY_PHASE
 #define MASK_fmi2SetDebugLogging ANY_PHASE
 #define MASK_fmi2GetFMUstate ANY_PHASE
@@ -676,7 +678,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 {
     Wrapper *w = (Wrapper *)c;
     if (!USABLE(fmi2GetString)) return fmi2Error;
-    if (!check_vrs(w, vr, nvr, value, "S", "fmi2GetString", "a String variable")) return fmi2Error;
+    if (!check_vrs(w, vr, nvr, value, "E", "fmi2GetString", "preset (the Enumeration, also by name)")) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     return outcome(w, p_fmi2GetString(w->inner, vr, nvr, value), "fmi2GetString");
 }
@@ -685,7 +687,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 {
     Wrapper *w = (Wrapper *)c;
     if (!USABLE(fmi2SetString)) return fmi2Error;
-    if (!check_vrs(w, vr, nvr, value, "S", "fmi2SetString", "a String variable")) return fmi2Error;
+    if (!check_vrs(w, vr, nvr, value, "E", "fmi2SetString", "preset (the Enumeration, also by name)")) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         if (!value[i]) { say(w, fmi2Error, "fmi2SetString: null string"); return fmi2Error; }
         if (!valid_utf8((const unsigned char *)value[i])) {
@@ -707,8 +709,24 @@ fmi2Status F(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, TYPE va
     say(w, fmi2Error, #F ": this FMU has no " T " variables"); \
     return fmi2Error; \
 }
-NO_VARIABLES(fmi2GetInteger, "Integer", fmi2Integer)
-NO_VARIABLES(fmi2SetInteger, "Integer", const fmi2Integer)
+/* Integer access: the Enumeration preset (SPEC section 15) */
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[])
+{
+    Wrapper *w = (Wrapper *)c;
+    if (!USABLE(fmi2GetInteger)) return fmi2Error;
+    if (!check_vrs(w, vr, nvr, value, "E", "fmi2GetInteger", "an Enumeration variable")) return fmi2Error;
+    if (nvr == 0) return fmi2OK;
+    return outcome(w, p_fmi2GetInteger(w->inner, vr, nvr, value), "fmi2GetInteger");
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[])
+{
+    Wrapper *w = (Wrapper *)c;
+    if (!USABLE(fmi2SetInteger)) return fmi2Error;
+    if (!check_vrs(w, vr, nvr, value, "E", "fmi2SetInteger", "an Enumeration variable")) return fmi2Error;
+    if (nvr == 0) return fmi2OK;
+    return outcome(w, p_fmi2SetInteger(w->inner, vr, nvr, value), "fmi2SetInteger");
+}
 NO_VARIABLES(fmi2GetBoolean, "Boolean", fmi2Boolean)
 NO_VARIABLES(fmi2SetBoolean, "Boolean", const fmi2Boolean)
 

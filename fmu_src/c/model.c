@@ -657,6 +657,43 @@ int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value)
     return -1;
 }
 
+/* preset, the Enumeration (SPEC section 15): value k is the k-th preset, 1-based */
+int model_get_integer(ModelInstance *c, fmi2ValueReference vr, int *value)
+{
+#if LCV_HAS_PRESET
+    if (vr == vr_preset) {
+        int k = find_vehicle(c->s.preset);
+        *value = k < 0 ? 0 : k + 1;   /* 0: a name set through SetString that is no preset */
+        return 0;
+    }
+#endif
+    *value = 0;
+    snprintf(c->msg, sizeof c->msg, "%u is not the value reference of an Enumeration variable", (unsigned)vr);
+    return -1;
+}
+
+int model_set_integer(ModelInstance *c, fmi2ValueReference vr, long long value)
+{
+#if LCV_HAS_PRESET
+    if (vr == vr_preset) {
+        if (value < 1 || value > LCV_N_VEHICLES) {
+            snprintf(c->msg, sizeof c->msg, "preset: %lld is not a preset; valid: 1 to %d (%s)", value,
+                     LCV_N_VEHICLES, LCV_PRESET_LIST);
+            return -1;
+        }
+        if (!(c->s.phase & (PhaseInstantiated | PhaseInitializationMode))) {
+            snprintf(c->msg, sizeof c->msg, "preset is a fixed parameter: it cannot change after initialization");
+            return -1;
+        }
+        snprintf(c->s.preset, sizeof c->s.preset, "%s", LCV_VEHICLES[value - 1].name);
+        return 0;
+    }
+#endif
+    (void)value;
+    snprintf(c->msg, sizeof c->msg, "%u is not the value reference of an Enumeration variable", (unsigned)vr);
+    return -1;
+}
+
 /* ------------------------------------------------------------------ FMU state */
 int model_check_state(ModelInstance *c, const ModelState *s)
 {

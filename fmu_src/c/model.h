@@ -80,6 +80,8 @@ int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, 
 int model_set_real(ModelInstance *c, fmi2ValueReference vr, double value);
 int model_get_string(ModelInstance *c, fmi2ValueReference vr, const char **value);
 int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value);
+int model_get_integer(ModelInstance *c, fmi2ValueReference vr, int *value);
+int model_set_integer(ModelInstance *c, fmi2ValueReference vr, long long value);
 /* Model Exchange (SPEC section 15): the continuous states of the interface (v1, r.., theta..,
    psi1, Y1; 0 for what the vehicle lacks) and their derivatives at the current inputs */
 void model_get_states(ModelInstance *c, double x[], size_t nx);

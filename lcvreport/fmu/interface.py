@@ -70,7 +70,10 @@ class FmuVariable:
     value_reference : int
     causality : {"parameter", "input", "output"}
     variability : {"fixed", "continuous"}
-    type : {"Real", "String"}
+    type : {"Real", "Enumeration"}
+        ``preset`` is an Enumeration (FMI 2: ``fmi2Get/SetInteger``; FMI 3: ``fmi3Get/SetInt64``)
+        whose items are ``items`` numbered from 1; its name is also accepted through
+        ``fmi2SetString``/``fmi3SetString`` (what FMUs before SPEC section 15 took).
     quantity : str
         Key of :data:`UNITS` (the FMI unit and display unit follow from it).
     start : float, str or None
@@ -85,6 +88,8 @@ class FmuVariable:
         Valid range (from :data:`lcvreport.ranges.RANGES`), written as min/max.
     display_unit : str
         Display unit ('' for none).
+    items : tuple of str
+        The Enumeration's items (value k+1 is ``items[k]``); empty for Real variables.
     """
 
     name: str
@@ -99,6 +104,7 @@ class FmuVariable:
     minimum: float | None = None
     maximum: float | None = None
     display_unit: str = ""
+    items: tuple = ()
 
     @property
     def unit(self) -> str:
@@ -191,7 +197,7 @@ class _Table:
         self.display = DISPLAY_UNITS[display]
 
     def add(self, name, causality, variability, quantity, start, description, source, type_="Real", range_key=None,
-            maximum=None):
+            maximum=None, items=()):
         lo = hi = None
         if range_key is not None:
             r = RANGES[range_key]
@@ -199,7 +205,7 @@ class _Table:
         if maximum is not None:
             hi = maximum
         self.vars.append(FmuVariable(name, len(self.vars), causality, variability, type_, quantity, start,
-                                     description, source, lo, hi, self.display.get(quantity, "")))
+                                     description, source, lo, hi, self.display.get(quantity, ""), tuple(items)))
 
 
 def _parameters(t: _Table) -> None:
@@ -234,12 +240,25 @@ def _tail_outputs(t: _Table, last: str) -> None:
           "Largest real part of the eigenvalues at the current (clamped) speed: negative = stable", ("max_real_eig",))
 
 
+def preset_value(name: str) -> int:
+    """The value of the preset FMU's Enumeration parameter ``preset`` that picks the preset ``name``.
+
+    >>> preset_value("aucnat"), preset_value("tractor_semitrailer")
+    (1, 6)
+    """
+    if name not in PRESETS:
+        raise KeyError(f"preset: unknown preset {name!r}; valid: {', '.join(PRESETS)}")
+    return PRESETS.index(name) + 1
+
+
 def preset_interface() -> Interface:
     """The SPEC section 5 interface (``LCV``/``LCVNative``), with ``ay1 .. ay6`` appended."""
     from ..model.presets import load_preset
     t = _Table("thesis")
-    t.add("preset", "parameter", "fixed", "none", PRESETS[0], "Vehicle preset: " + ", ".join(PRESETS),
-          ("parameter", "preset"), type_="String")
+    t.add("preset", "parameter", "fixed", "none", PRESETS[0],
+          "Vehicle preset (Enumeration: " + ", ".join(f"{k} {p}" for k, p in enumerate(PRESETS, 1))
+          + "; the name through SetString is accepted too)", ("parameter", "preset"), type_="Enumeration",
+          items=PRESETS)
     _parameters(t)
     _speed_and_steer(t, "the tractor steer axle 11")
     for a in PRESET_AXLES:

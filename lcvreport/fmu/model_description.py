@@ -144,12 +144,22 @@ def _initial_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
     return []
 
 
+def enumeration_type_name(v: FmuVariable) -> str:
+    """The declared type of an Enumeration variable: ``preset`` -> ``Preset``."""
+    return v.name[:1].upper() + v.name[1:]
+
+
+def enumeration_value(v: FmuVariable, item: str) -> int:
+    """The value (1-based) of ``item`` of the Enumeration variable ``v``."""
+    return v.items.index(item) + 1
+
+
 def guid(itf: Interface, model_identifier: str) -> str:
     """A guid derived from the interface and the vehicles' numbers (reproducible)."""
     h = hashlib.sha256()
     h.update(model_identifier.encode())
     for v in itf.variables:
-        h.update(repr((v.name, v.causality, v.variability, v.unit, v.start, v.source)).encode())
+        h.update(repr((v.name, v.type, v.causality, v.variability, v.unit, v.start, v.source)).encode())
     for veh in itf.vehicles:
         h.update(repr(veh).encode())
     return "{" + str(uuid.UUID(bytes=h.digest()[:16], version=5)) + "}"
@@ -206,6 +216,12 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
     for name, attrs in declared.values():
         SubElement(SubElement(types, "SimpleType", name=name), "Real", attrs)
     declared = {key: name for key, (name, _attrs) in declared.items()}
+    for v in itf.variables:     # the Enumeration of the presets (SPEC section 15)
+        if v.type == "Enumeration":
+            enum = SubElement(SubElement(types, "SimpleType", name=enumeration_type_name(v),
+                                         description=f"Values of {v.name}"), "Enumeration")
+            for k, item in enumerate(v.items, 1):
+                SubElement(enum, "Item", name=item, value=str(k))
     cats = SubElement(root, "LogCategories")
     for name, text in LOG_CATEGORIES.items():
         SubElement(cats, "Category", name=name, description=text)
@@ -213,8 +229,9 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
     mv = SubElement(root, "ModelVariables")
     for v in itf.variables:
         sv = SubElement(mv, "ScalarVariable", variable_attributes(v))
-        if v.type == "String":
-            SubElement(sv, "String", {"start": str(v.start)})
+        if v.type == "Enumeration":
+            SubElement(sv, "Enumeration", {"declaredType": enumeration_type_name(v),
+                                           "start": str(enumeration_value(v, v.start))})
             continue
         real = {}
         if (v.quantity, v.display_unit) in declared:

@@ -1,7 +1,7 @@
 """modelDescription.xml and buildDescription.xml of the FMI 3.0 native FMU (SPEC section 15).
 
 The same interface table, units, types and dependencies as the FMI 2.0 file
-(:mod:`lcvreport.fmu.model_description`), in FMI 3.0's form: ``Float64``/``String``
+(:mod:`lcvreport.fmu.model_description`), in FMI 3.0's form: ``Float64``/``Enumeration``
 variables, an ``instantiationToken``, an independent variable ``time`` (its value
 reference after the derivatives), ``<ModelStructure>`` by value reference, and the sources
 listed in ``sources/buildDescription.xml`` so that ``fmpy compile`` rebuilds the binary.
@@ -19,7 +19,8 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from .interface import Interface
 from .model_description import (DEFAULT_EXPERIMENT, LOG_CATEGORIES, UNIT_DERIVATIVE, _direct_dependencies,
-                                _initial_dependencies, _num, _state_dependencies, declared_types, guid,
+                                _initial_dependencies, _num, _state_dependencies, declared_types,
+                                enumeration_type_name, enumeration_value, guid,
                                 unit_definitions, variable_attributes)
 
 #: the C sources of the FMI 3.0 native FMU (built with LCV_FMI3 defined)
@@ -53,6 +54,12 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
     for key, (name, attrs) in declared_types(itf).items():
         SubElement(types, "Float64Type", {"name": name, **attrs})
         declared[key] = name
+    for v in itf.variables:
+        if v.type == "Enumeration":
+            enum = SubElement(types, "EnumerationType", name=enumeration_type_name(v),
+                              description=f"Values of {v.name}")
+            for k, item in enumerate(v.items, 1):
+                SubElement(enum, "Item", name=item, value=str(k))
     cats = SubElement(root, "LogCategories")
     for name, text in LOG_CATEGORIES.items():
         SubElement(cats, "Category", name=name, description=text)
@@ -63,8 +70,9 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
                                "variability": "continuous", "unit": "s", "description": "Simulation time"})
     for v in itf.variables:
         attrs = variable_attributes(v)
-        if v.type == "String":
-            SubElement(SubElement(mv, "String", attrs), "Start", value=str(v.start))
+        if v.type == "Enumeration":
+            SubElement(mv, "Enumeration", {**attrs, "declaredType": enumeration_type_name(v),
+                                           "start": str(enumeration_value(v, v.start))})
             continue
         if (v.quantity, v.display_unit) in declared:
             attrs["declaredType"] = declared[(v.quantity, v.display_unit)]

@@ -21,7 +21,7 @@ import sys
 
 import numpy as np
 
-from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real, String
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.enums import Fmi2Status
 
 from ..model.vehicle_file import load_vehicle
@@ -91,7 +91,8 @@ class LCV(Fmi2Slave):
                       description=v.description)
             if v.causality == "output":
                 kw["initial"] = Fmi2Initial.calculated
-            var = (String if v.type == "String" else Real)(v.name, getter=lambda: 0.0, setter=lambda x: None, **kw)
+            var = (Integer if v.type == "Enumeration" else Real)(v.name, getter=lambda: 0, setter=lambda x: None,
+                                                                 **kw)
             self.register_variable(var)
             assert var.value_reference == v.value_reference
 
@@ -253,33 +254,60 @@ class LCV(Fmi2Slave):
             self._values_speed = None
             self._template = self._parameter_values()
 
+    def _enumeration(self, vr):
+        """The Enumeration variable of value reference ``vr`` (``preset``), or None."""
+        if isinstance(vr, int) and 0 <= vr < len(self.itf.variables) and \
+                self.itf.variables[vr].type == "Enumeration":
+            return self.itf.variables[vr]
+        return None
+
     def get_string(self, vrs):
         out = [""] * len(vrs)
         for i, vr in enumerate(vrs):
-            if 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].type == "String":
-                out[i] = str(self.params[self.itf.variables[vr].name])
+            var = self._enumeration(vr)
+            if var is not None:
+                out[i] = str(self.params[var.name])
             else:
-                self._error(f"fmi2GetString: {vr} is not the value reference of a String variable")
+                self._error(f"fmi2GetString: {vr} is not the value reference of preset (the Enumeration, also by "
+                            "name)")
         return out
 
     def set_string(self, vrs, values):
         try:
             for vr, value in zip(vrs, values):
-                if 0 <= vr < len(self.itf.variables) and self.itf.variables[vr].type == "String":
-                    self._set_parameter(self.itf.variables[vr].name, str(value))
+                var = self._enumeration(vr)
+                if var is not None:
+                    self._set_parameter(var.name, str(value))
                 else:
-                    self._error(f"fmi2SetString: {vr} is not the value reference of a String variable")
+                    self._error(f"fmi2SetString: {vr} is not the value reference of preset (the Enumeration, also "
+                                "by name)")
         except Exception as exc:  # noqa: BLE001
             self._error(f"fmi2SetString failed: {type(exc).__name__}: {exc}")
 
     def get_integer(self, vrs):
-        if len(vrs):
-            self._error("fmi2GetInteger: this FMU has no Integer variables")
-        return [0] * len(vrs)
+        out = [0] * len(vrs)
+        for i, vr in enumerate(vrs):
+            var = self._enumeration(vr)
+            if var is None:
+                self._error(f"fmi2GetInteger: {vr} is not the value reference of an Enumeration variable")
+            else:   # 0: a name set through fmi2SetString that is no preset
+                name = self.params[var.name]
+                out[i] = var.items.index(name) + 1 if name in var.items else 0
+        return out
 
     def set_integer(self, vrs, values):
-        if len(vrs):
-            self._error("fmi2SetInteger: this FMU has no Integer variables")
+        try:
+            for vr, value in zip(vrs, values):
+                var = self._enumeration(vr)
+                if var is None:
+                    self._error(f"fmi2SetInteger: {vr} is not the value reference of an Enumeration variable")
+                elif not 1 <= int(value) <= len(var.items):
+                    self._error(f"fmi2SetInteger: {var.name}: {int(value)} is not a {var.name}; valid: 1 to "
+                                f"{len(var.items)} ({', '.join(var.items)})")
+                else:
+                    self._set_parameter(var.name, var.items[int(value) - 1])
+        except Exception as exc:  # noqa: BLE001
+            self._error(f"fmi2SetInteger failed: {type(exc).__name__}: {exc}")
 
     def get_boolean(self, vrs):
         if len(vrs):
