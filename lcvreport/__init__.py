@@ -54,7 +54,9 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``model_description3`` the FMI 3.0 modelDescription.xml and buildDescription.xml
     ``driver``           the driver FMU (FMI 2.0 CS and ME, C99) of analysis.driver
     ``engine``           the co-simulation engine (numpy only)
-    ``slave``            the pythonfmu slave class, a thin map onto the engine
+    ``slave_core``       what the Python FMUs compute, FMI calls by value reference onto the engine
+    ``slave``            the FMI 2.0 slave class: the core behind pythonfmu
+    ``slave3``           the FMI 3.0 slave class: the core behind pythonfmu3
     ``build``            builders of the pythonfmu and the C FMU (sources in the
                          repository's ``fmu_src/``, installed as ``lcvreport.fmu_src``)
 ``report/``              **the reports** (notebooks in ``notebooks/``, installed as

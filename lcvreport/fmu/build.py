@@ -469,12 +469,12 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
         (tmp / "loader_config.h").write_text(loader_config_header(itf, model_identifier, fmu_guid, env), "utf-8")
         loader = tmp / f"{model_identifier}.so"
         # Python.h for the types of the initialization API only (the loader links no libpython)
-        _compile([src / "c" / "loader.c", src / "c" / "fmi2_shared.c"],
+        _compile([src / "c" / "loader.c", src / "c" / "pyruntime.c", src / "c" / "fmi2_shared.c"],
                  [tmp, src / "c", fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
                  ["-ldl", "-lpthread"])
         files[f"binaries/linux64/{model_identifier}.so"] = loader.read_bytes()
         files[f"binaries/linux64/{EXPORT_LIB}"] = export
-        for name in ("loader.c", "fmi2_shared.c", "fmi2_shared.h"):
+        for name in ("loader.c", "pyruntime.c", "pyruntime.h", "fmi2_shared.c", "fmi2_shared.h"):
             files[f"sources/{name}"] = (src / "c" / name).read_bytes()
         files["sources/loader_config.h"] = (tmp / "loader_config.h").read_bytes()
         files.update(documentation_files(itf, model_identifier, native=False))

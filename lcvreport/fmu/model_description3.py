@@ -32,22 +32,29 @@ def time_value_reference(itf: Interface) -> int:
     return len(itf.variables) + len(itf.continuous_states)
 
 
-def model_description3(itf: Interface, model_identifier: str, generation_tool: str = "lcvreport") -> bytes:
-    """The FMI 3.0 modelDescription.xml of the native FMU of ``itf`` (Co-Simulation and Model Exchange)."""
+def model_description3(itf: Interface, model_identifier: str, generation_tool: str = "lcvreport",
+                       native: bool = True) -> bytes:
+    """The FMI 3.0 modelDescription.xml of an FMU of ``itf``: the native FMU (Co-Simulation and
+    Model Exchange, directional derivatives) or, with ``native=False``, the Python FMU
+    (Co-Simulation only, ``needsExecutionTool="true"``)."""
     root = Element("fmiModelDescription", {
         "fmiVersion": "3.0", "modelName": model_identifier, "instantiationToken": guid(itf, model_identifier),
-        "description": itf.description + " Native C implementation: no Python at run time.",
+        "description": itf.description + (" Native C implementation: no Python at run time." if native else
+                                          " Runs the lcvreport package in an embedded Python (pythonfmu3)."),
         "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": generation_tool,
         "variableNamingConvention": "flat"})
-    SubElement(root, "ModelExchange", {
-        "modelIdentifier": model_identifier, "canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
-        "needsCompletedIntegratorStep": "false", "providesDirectionalDerivatives": "true"})
+    if native:
+        SubElement(root, "ModelExchange", {
+            "modelIdentifier": model_identifier, "canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
+            "needsCompletedIntegratorStep": "false", "providesDirectionalDerivatives": "true"})
     SubElement(root, "CoSimulation", {
-        "modelIdentifier": model_identifier, "canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
+        "modelIdentifier": model_identifier, "needsExecutionTool": "false" if native else "true",
+        "canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
         "canHandleVariableCommunicationStepSize": "true", "hasEventMode": "false",
-        "providesIntermediateUpdate": "false", "providesDirectionalDerivatives": "true"})
+        "providesIntermediateUpdate": "false", "providesDirectionalDerivatives": "true" if native else "false"})
+    states = itf.continuous_states if native else ()
     used = {v.unit for v in itf.variables if v.unit}
-    used |= {UNIT_DERIVATIVE[v.unit] for v in itf.continuous_states if v.unit in UNIT_DERIVATIVE}
+    used |= {UNIT_DERIVATIVE[v.unit] for v in states if v.unit in UNIT_DERIVATIVE}
     unit_definitions(root, used | {"s"})
     types = SubElement(root, "TypeDefinitions")
     declared = {}
@@ -89,7 +96,7 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
             attrs["start"] = _num(v.start)
         SubElement(mv, "Float64", attrs)
     der_vr = {}
-    for k, sv in enumerate(itf.continuous_states):
+    for k, sv in enumerate(states):
         vr = len(itf.variables) + k
         der_vr[sv.name] = vr
         attrs = {"name": f"der({sv.name})", "valueReference": str(vr), "description": f"Time derivative of {sv.name}",
@@ -99,17 +106,17 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
             attrs["unit"] = UNIT_DERIVATIVE[sv.unit]
         SubElement(mv, "Float64", attrs)
     vr_of = {v.name: v.value_reference for v in itf.variables}
-    states = _state_dependencies(itf)
+    state_deps = _state_dependencies(itf) if native else None
     ms = SubElement(root, "ModelStructure")
     for v in itf.outputs:
-        deps = " ".join(str(i) for i in sorted(vr_of[n] for n in _direct_dependencies(itf, v, states)))
+        deps = " ".join(str(i) for i in sorted(vr_of[n] for n in _direct_dependencies(itf, v, state_deps)))
         SubElement(ms, "Output", {"valueReference": str(v.value_reference), "dependencies": deps})
-    for sv in itf.continuous_states:
+    for sv in states:
         SubElement(ms, "ContinuousStateDerivative", {"valueReference": str(der_vr[sv.name])})
     for v in itf.outputs:
         deps = " ".join(str(i) for i in sorted(vr_of[n] for n in _initial_dependencies(itf, v)))
         SubElement(ms, "InitialUnknown", {"valueReference": str(v.value_reference), "dependencies": deps})
-    for sv in itf.continuous_states:
+    for sv in states:
         SubElement(ms, "InitialUnknown", {"valueReference": str(der_vr[sv.name])})
     indent(root)
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + tostring(root, encoding="utf-8") + b"\n"
