@@ -3,7 +3,7 @@
 #
 #   ./build.sh          set up, build the FMUs, build the report
 #   ./build.sh setup    system packages (Debian) + .venv with pinned Python packages
-#   ./build.sh fmu      build/LCV.fmu (pythonfmu) and build/LCVNative.fmu (C)
+#   ./build.sh fmu      build/LCV.fmu, build/LCV3.fmu (pythonfmu, pythonfmu3) and build/LCVNative.fmu, build/LCVNative3.fmu (C)
 #   ./build.sh report   execute the notebooks, write build/report/{index.html,report.pdf,data/}
 #   ./build.sh test     set up, build the FMUs, run the whole test suite
 set -euo pipefail

@@ -8,7 +8,7 @@ Fixed contract (other parts and outside checks call these forms)::
     lcv steady   (...) --load UNITS [--convention C] --json
     lcv simulate (...) --load UNITS [--t-end T] [--dt H] [--json]
     lcv measures (...) [--load UNITS] --json
-    lcv fmu      (--preset NAME | --vehicle FILE) --out DIR [--kind python|native|both]
+    lcv fmu      (--preset NAME | --vehicle FILE) --out DIR [--kind python|native|both] [--fmi 2|3]
     lcv report   (--preset NAME | --vehicle FILE) [--speed-kph V] [--load UNITS] --out DIR
     lcv presets  [--json]
 
@@ -171,9 +171,10 @@ def build_parser() -> argparse.ArgumentParser:
     source(fmu, masses=False)
     fmu.add_argument("--out", required=True, metavar="DIR", help="output folder")
     fmu.add_argument("--kind", default=None, choices=("python", "native", "both"),
-                     help="python (pythonfmu), native (C99) or both (default: both for FMI 2.0, native for 3.0)")
+                     help="python (pythonfmu, pythonfmu3 for FMI 3.0), native (C99) or both (default both)")
     fmu.add_argument("--fmi", default="2", choices=("2", "3"),
-                     help="FMI version (default 2); FMI 3.0 is built native only so far")
+                     help="FMI version (default 2): <name>.fmu and <name>Native.fmu, or <name>3.fmu and "
+                          "<name>Native3.fmu")
     speed(fmu, required=False)
     rep = sub.add_parser("report", help="assessment report of the vehicle (HTML and PDF)")
     source(rep, masses=False)
@@ -641,10 +642,7 @@ def _cmd_fmu(args, out: _Out) -> int:
         kw = {}
         if args.speed_kph is not None or args.speed_mph is not None:
             kw["u_start_mps"] = _speed_mps(args)      # the start value of the input u
-        kind = args.kind or ("both" if args.fmi == "2" else "native")
-        if args.fmi == "3" and kind != "native":
-            raise UsageError(f"argument --kind: FMI 3.0 FMUs are built native only (the Python FMU is FMI 2.0 so "
-                             f"far); use --kind native, got {kind}")
+        kind = args.kind or "both"
         paths = build_vehicle_fmus(v, args.out, kind=kind, fmi=int(args.fmi), **kw)
     except FmuBuildError as exc:
         raise OutputError(str(exc)) from None

@@ -37,15 +37,35 @@ def native3_fmu(native_fmu):
 
 
 @pytest.fixture(scope="session")
-def example3_fmus(tmp_path_factory):
+def python3_fmu(native3_fmu):
+    path = BUILD / "LCV3.fmu"
+    if not path.exists():
+        subprocess.run([sys.executable, "-m", "lcvreport.fmu.build", "--out", str(BUILD)], check=True, cwd=ROOT)
+    return path
+
+
+@pytest.fixture(scope="session")
+def example3_all(tmp_path_factory):
+    """``lcv fmu --vehicle X --fmi 3`` (both kinds) of every example vehicle."""
     out = tmp_path_factory.mktemp("fmi3")
     paths = {}
     for name in EXAMPLE_NAMES:
         p = subprocess.run([sys.executable, "-m", "lcvreport.cli", "fmu", "--vehicle", str(EXAMPLES / f"{name}.toml"),
                             "--out", str(out), "--fmi", "3"], capture_output=True, text=True)
         assert p.returncode == 0, p.stderr
-        paths[name] = out / f"{name}Native3.fmu"
+        paths[name] = {"native": out / f"{name}Native3.fmu", "python": out / f"{name}3.fmu"}
+        assert all(f.exists() for f in paths[name].values()), p.stdout
     return paths
+
+
+@pytest.fixture(scope="session")
+def example3_fmus(example3_all):
+    return {name: f["native"] for name, f in example3_all.items()}
+
+
+@pytest.fixture(scope="session")
+def example3_python_fmus(example3_all):
+    return {name: f["python"] for name, f in example3_all.items()}
 
 
 class Log:
@@ -67,6 +87,58 @@ def _slave(fmu, log, preset=None, logging=True):
     if preset:
         s.setInt64([vr["preset"]], [preset_value(preset)])
     return s, vr, md
+
+
+def test_every_python_fmi3_fmu_validates(python3_fmu, example3_python_fmus):
+    """The Python FMI 3.0 FMUs: fmpy validate clean, Co-Simulation only, needsExecutionTool,
+    the loader beside pythonfmu3's library, preset an Enumeration in the preset FMU."""
+    import xml.etree.ElementTree as ET
+    for fmu in [python3_fmu, *example3_python_fmus.values()]:
+        p = subprocess.run([str(Path(sys.executable).parent / "fmpy"), "validate", str(fmu)], capture_output=True,
+                           text=True)
+        assert p.returncode == 0 and "No problems found" in p.stdout, (fmu.name, p.stdout + p.stderr)
+        root = ET.fromstring(zipfile.ZipFile(fmu).read("modelDescription.xml"))
+        assert root.get("fmiVersion") == "3.0" and root.find("ModelExchange") is None
+        cs = root.find("CoSimulation")
+        assert cs.get("modelIdentifier") == fmu.stem and cs.get("needsExecutionTool") == "true"
+        names = zipfile.ZipFile(fmu).namelist()
+        assert {f"binaries/x86_64-linux/{fmu.stem}.so", "binaries/x86_64-linux/libpythonfmu3-export.so",
+                "documentation/index.html", "documentation/licenses/license.txt"} <= set(names)
+        assert (root.find("ModelVariables/Enumeration[@name='preset']") is not None) == (fmu == python3_fmu)
+
+
+@pytest.mark.parametrize("preset", ["aucnat", "tractor_semitrailer"])
+def test_python_fmi3_co_simulation_is_the_exact_response(python3_fmu, preset):
+    """The Python FMI 3.0 FMU through fmpy: every output within 10 kappa eps of the package."""
+    test_co_simulation_is_the_exact_response(python3_fmu, preset)
+
+
+def test_python_fmi3_fmus_in_fmusim_with_no_ld_preload(python3_fmu, example3_python_fmus, tmp_path):
+    """Reference-FMUs' fmusim (a plain C host) loads the Python FMI 3.0 FMUs with no LD_PRELOAD
+    and no PYTHONPATH and gives the package's exact response (Co-Simulation, 1e-12)."""
+    H, N = 0.05, 40
+    for fmu, preset in [(python3_fmu, "legal_max")] + [(f, None) for f in example3_python_fmus.values()]:
+        itf = interface_of_fmi3(fmu)
+        inputs = _constant_case(itf)
+        outs = [v.name for v in itf.outputs]
+        names = outs[:outs.index("Y_rear") + 1]
+        ref = reference_outputs(itf, [(H, inputs)] + [(H, {})] * (N - 1), preset)
+        with open(tmp_path / "in.csv", "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["time", *inputs])
+            for t in (0.0, N * H):
+                w.writerow([t, *inputs.values()])
+        args = [str(FMUSIM), "--interface-type", "cs", "--stop-time", str(N * H), "--output-interval", str(H),
+                "--input-file", str(tmp_path / "in.csv"), "--output-file", str(tmp_path / "out.csv")]
+        if preset:
+            args += ["--start-value", "preset", str(preset_value(preset))]
+        p = subprocess.run(args + [str(fmu)], capture_output=True, text=True, env=host_env(), timeout=300)
+        assert p.returncode == 0, (fmu.name, (p.stdout + p.stderr)[-2000:])
+        with open(tmp_path / "out.csv") as f:
+            rows = list(csv.DictReader(f))
+        got = np.array([[float(r[n]) for n in names] for r in rows[1:N + 1]])
+        err, name = group_error(got, ref, itf)
+        assert err <= 1e-12, (fmu.name, name, err)
 
 
 def test_every_fmi3_fmu_validates(native3_fmu, example3_fmus):

@@ -481,17 +481,98 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
         return _zip(out_dir / f"{model_identifier}.fmu", files)
 
 
+#: pythonfmu3's export library inside the FMI 3.0 Python FMU (the loader, loader3.c, loads it)
+EXPORT_LIB3 = "libpythonfmu3-export.so"
+SLAVE3_TEMPLATE = '''"""The slave module pythonfmu3 imports from the FMU's resources (once per process, under this
+file's name, which carries the FMU's own hash): the class extends lcvreport's FMI 3.0 slave of
+the package bundled next to this file under a name of its own, so a Python host that has
+imported another lcvreport neither runs it nor is disturbed by it."""
+from pythonfmu3 import Fmi3Slave
+
+from {alias}.fmu.slave3 import LCV3 as _LCV3
+
+
+class {cls}(_LCV3, Fmi3Slave):
+    MODEL_IDENTIFIER = {identifier!r}
+'''
+
+
+def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env: dict | None = None) -> Path:
+    """The FMI 3.0 Python FMU ``<model_identifier>.fmu`` (Co-Simulation, pythonfmu3 0.3.4) with
+    the loader (``loader3.c``) as its binary, so that plain C hosts load it (SPEC section 15)."""
+    from .model_description3 import model_description3
+    out_dir = Path(out_dir).resolve()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    fmu_guid = guid(itf, model_identifier)
+    src = source_dir()
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        proj = tmp / "project"
+        proj.mkdir()
+        alias = bundled_package_name(fmu_guid)
+        module = "lcv_slave3_" + alias.rsplit("_", 1)[1]      # unique per FMU: pythonfmu3 imports it by name
+        (proj / f"{module}.py").write_text(SLAVE3_TEMPLATE.format(alias=alias, cls="LCVSlave3",
+                                                                  identifier=model_identifier), encoding="utf-8")
+        cfg = {"mode": "presets"} if itf.preset_mode else {
+            "mode": "vehicle", "vehicle_file": "vehicle.toml",
+            "u_start_mps": next(v.start for v in itf.variables if v.name == "u")}
+        (proj / "lcv_fmu.json").write_text(json.dumps(cfg), encoding="utf-8")
+        extra = [proj / "lcv_fmu.json"]
+        if not itf.preset_mode:
+            (proj / "vehicle.toml").write_text(dumps_vehicle(itf.vehicles[0]), encoding="utf-8")
+            extra.append(proj / "vehicle.toml")
+        _package_copy(proj, alias)
+        built = tmp / "built"
+        cmd = [sys.executable, "-m", "pythonfmu3", "build", "-f", str(proj / f"{module}.py"), "-d", str(built),
+               "--handle-state", "--serialize-state", *map(str, extra), str(proj / alias)]
+        env_build = dict(os.environ, PYTHONPATH=str(proj) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+        p = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp, env=env_build)
+        fmu = built / f"{model_identifier}.fmu"
+        if p.returncode != 0 or not fmu.exists():
+            raise FmuBuildError(f"pythonfmu3 build failed:\n{p.stdout[-2000:]}\n{p.stderr[-4000:]}")
+        with zipfile.ZipFile(fmu) as zf:
+            files = {n: zf.read(n) for n in zf.namelist() if not n.endswith("/")}
+        export = files.pop(f"binaries/x86_64-linux/{model_identifier}.so")
+        for name in [n for n in files if n.startswith("binaries/")]:
+            files.pop(name)   # pythonfmu3's Windows library: the loader is Linux-only
+        files["modelDescription.xml"] = model_description3(itf, model_identifier, native=False,
+                                                           generation_tool="lcvreport.fmu.build (pythonfmu3 0.3.4)")
+        from .model_description3 import time_value_reference
+        config = loader_config_header(itf, model_identifier, fmu_guid, env).replace(
+            f"#define LOADER_EXPORT_LIB {_c_string(EXPORT_LIB)}", f"#define LOADER_EXPORT_LIB {_c_string(EXPORT_LIB3)}")
+        config = config.replace("#endif", f"#define LOADER_TIME_VR {time_value_reference(itf)}\n#endif")
+        (tmp / "loader_config.h").write_text(config, "utf-8")
+        loader = tmp / f"{model_identifier}.so"
+        _compile([src / "c" / "loader3.c", src / "c" / "pyruntime.c", src / "c" / "fmi2_shared.c"],
+                 [tmp, src / "c", fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
+                 ["-ldl", "-lpthread"], defines=["LCV_FMI3"])
+        files[f"binaries/x86_64-linux/{model_identifier}.so"] = loader.read_bytes()
+        files[f"binaries/x86_64-linux/{EXPORT_LIB3}"] = export
+        for name in ("loader3.c", "pyruntime.c", "pyruntime.h", "fmi2_shared.c", "fmi2_shared.h"):
+            files[f"sources/{name}"] = (src / "c" / name).read_bytes()
+        files["sources/loader_config.h"] = (tmp / "loader_config.h").read_bytes()
+        doc = documentation_files(itf, model_identifier, native=False)
+        doc["documentation/index.html"] = doc["documentation/index.html"].replace(
+            b"FMI 2.0 Co-Simulation FMU", b"FMI 3.0 Co-Simulation FMU").replace(b"pythonfmu's", b"pythonfmu3's")
+        doc["documentation/licenses/license.txt"] = doc["documentation/licenses/license.txt"].replace(
+            b"pythonfmu 0.7.0 (resources/pythonfmu, binaries/linux64/pythonfmu-export.so)",
+            b"pythonfmu3 0.3.4 (resources/pythonfmu3, binaries/x86_64-linux/libpythonfmu3-export.so)")
+        files.update(doc)
+        return _zip(out_dir / f"{model_identifier}.fmu", files)
+
+
 def build_preset_fmus(out_dir: Path) -> list[Path]:
-    """``LCV.fmu`` and ``LCVNative.fmu`` (SPEC section 5), and ``LCVNative3.fmu`` (FMI 3.0, SPEC section 15)."""
+    """``LCV.fmu`` and ``LCVNative.fmu`` (SPEC section 5), and their FMI 3.0 siblings ``LCV3.fmu``
+    and ``LCVNative3.fmu`` (SPEC section 15)."""
     itf = preset_interface()
     return [build_python_fmu(itf, out_dir, "LCV"), build_native_fmu(itf, out_dir, "LCVNative"),
-            build_native_fmu3(itf, out_dir, "LCVNative3")]
+            build_python_fmu3(itf, out_dir, "LCV3"), build_native_fmu3(itf, out_dir, "LCVNative3")]
 
 
 def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both",
                        u_start_mps: float = U_START, fmi: int = 2) -> list[Path]:
     """``<name>.fmu`` (pythonfmu) and/or ``<name>Native.fmu`` (C99) of a vehicle (SPEC section 9);
-    with ``fmi=3``, ``<name>Native3.fmu`` (FMI 3.0, native only so far).
+    with ``fmi=3``, ``<name>3.fmu`` (pythonfmu3) and/or ``<name>Native3.fmu`` (SPEC section 15).
 
     Parameters
     ----------
@@ -507,11 +588,13 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
     if fmi not in (2, 3):
         raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
     itf = vehicle_interface(vehicle, u_start_mps)
-    if fmi == 3:
-        if kind != "native":
-            raise ValueError("FMI 3.0 FMUs are built native only (the Python FMU is FMI 2.0 so far)")
-        return [build_native_fmu3(itf, Path(out_dir), f"{vehicle.name}Native3")]
     out = []
+    if fmi == 3:
+        if kind in ("python", "both"):
+            out.append(build_python_fmu3(itf, Path(out_dir), f"{vehicle.name}3"))
+        if kind in ("native", "both"):
+            out.append(build_native_fmu3(itf, Path(out_dir), f"{vehicle.name}Native3"))
+        return out
     if kind in ("python", "both"):
         out.append(build_python_fmu(itf, Path(out_dir), vehicle.name))
     if kind in ("native", "both"):
@@ -521,7 +604,8 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
 
 def main(argv: list[str] | None = None) -> int:
     """Command-line entry of ``./build.sh fmu``: the preset FMUs into ``--out``."""
-    p = argparse.ArgumentParser(description="Build build/LCV.fmu (pythonfmu) and build/LCVNative.fmu (C99).")
+    p = argparse.ArgumentParser(description="Build build/LCV.fmu (pythonfmu), build/LCVNative.fmu (C99) and their "
+                                            "FMI 3.0 siblings build/LCV3.fmu and build/LCVNative3.fmu.")
     p.add_argument("--out", default="build", type=Path, help="output folder (default build)")
     args = p.parse_args(argv)
     try:

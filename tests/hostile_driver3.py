@@ -1,0 +1,223 @@
+"""One hostile call sequence against one FMI 3.0 FMU (native or Python), in a process of its own.
+
+    python hostile_driver3.py FMU CASE LOGGING [FAKE_LCVREPORT_PARENT]
+
+Calls the FMU's binary through ctypes (the raw API: null pointers, wrong counts, calls in the
+wrong phase, types the FMU has none of) and prints one JSON line: the status of every call,
+the error and warning messages the host received, whether every value read was finite, and
+-- for the Python FMU -- what differs in sys.path and sys.meta_path after fmi3FreeInstance.
+Then "survived": the process was not aborted, whatever the FMU.
+"""
+import ctypes
+import json
+import math
+import os
+import sys
+import tempfile
+import xml.etree.ElementTree as ET
+import zipfile
+
+V = ctypes.c_void_p
+LOG = ctypes.CFUNCTYPE(None, V, ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p)
+
+
+def main():
+    fmu, case, logging = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
+    if len(sys.argv) > 4:                              # a different lcvreport imported first
+        sys.path.insert(0, sys.argv[4])
+        import lcvreport  # noqa: F401
+        sys.path.remove(sys.argv[4])
+    before = {"path": list(sys.path), "meta": [repr(f) for f in sys.meta_path]}
+    d = tempfile.mkdtemp()
+    zipfile.ZipFile(fmu).extractall(d)
+    root = ET.parse(os.path.join(d, "modelDescription.xml")).getroot()
+    ident = root.find("CoSimulation").get("modelIdentifier")
+    token = root.get("instantiationToken").encode()
+    vr = {e.get("name"): int(e.get("valueReference")) for e in root.find("ModelVariables")}
+    lib = ctypes.CDLL(os.path.join(d, "binaries", "x86_64-linux", ident + ".so"))
+    records = []
+
+    @LOG
+    def log(_env, status, _category, message):
+        records.append((status, (message or b"").decode("utf-8", "replace")))
+
+    statuses, finite = [], [True]
+
+    def fn(name, restype, *argtypes):
+        f = getattr(lib, name)
+        f.restype, f.argtypes = restype, list(argtypes)
+        return f
+
+    def call(name, argtypes, *args):
+        s = fn(name, ctypes.c_int, *argtypes)(*args)
+        statuses.append(s)
+        return s
+
+    inst_cs = fn("fmi3InstantiateCoSimulation", V, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_bool,
+                 ctypes.c_bool, ctypes.c_bool, ctypes.c_bool, V, ctypes.c_size_t, V, LOG, V)
+    resources = (os.path.join(d, "resources") + "/").encode()
+
+    def instantiate(token=token, resources=resources, event=False):
+        return inst_cs(b"h", token, resources, False, logging, event, False, None, 0, None, log, None)
+
+    U = ctypes.c_uint
+    D = ctypes.c_double
+    B = ctypes.c_bool
+    S = ctypes.c_size_t
+
+    def arr(ctype, *values):
+        return (ctype * max(1, len(values)))(*values)
+
+    def step(c, h=0.01):
+        b1, b2, b3, t = B(), B(), B(), D()
+        return call("fmi3DoStep", [V, D, D, B, V, V, V, V], c, 0.0, h, True, ctypes.byref(b1), ctypes.byref(b2),
+                    ctypes.byref(b3), ctypes.byref(t))
+
+    def read(c):
+        names = [n for n in ("r1", "y2", "Y_rear", "max_real_eig") if n in vr]
+        out = arr(D, *[0.0] * len(names))
+        call("fmi3GetFloat64", [V, V, S, V, S], c, arr(U, *[vr[n] for n in names]), len(names), out, len(names))
+        finite[0] = finite[0] and all(math.isfinite(x) for x in out[:len(names)])
+
+    def init(c):
+        call("fmi3EnterInitializationMode", [V, B, D, D, B, D], c, False, 0.0, 0.0, False, 0.0)
+        call("fmi3ExitInitializationMode", [V], c)
+
+    free = fn("fmi3FreeInstance", None, V)
+    c = None
+    if case == "bad_token":
+        c = instantiate(token=b"{wrong}")
+        statuses.append(0 if c else 3)
+    elif case == "bad_resources":
+        c = instantiate(resources=b"/no/such/folder/")
+        statuses.append(0 if c else 3)
+    elif case == "null_resources":
+        c = instantiate(resources=None)
+        statuses.append(0 if c else 3)
+    elif case == "event_mode":
+        c = instantiate(event=True)
+        statuses.append(0 if c else 3)
+    elif case == "model_exchange_of_cs_only":
+        me = fn("fmi3InstantiateModelExchange", V, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_bool,
+                ctypes.c_bool, V, LOG)
+        c = me(b"h", token, resources, False, logging, None, log)
+        statuses.append(0 if c else 3)
+        if c:   # the native FMU has Model Exchange: drive it a little, then leave
+            call("fmi3EnterInitializationMode", [V, B, D, D, B, D], c, False, 0.0, 0.0, False, 0.0)
+            call("fmi3ExitInitializationMode", [V], c)
+            call("fmi3DoStep", [V, D, D, B, V, V, V, V], c, 0.0, 0.01, True, None, None, None, None)
+    else:
+        c = instantiate()
+        assert c, records
+        if case == "step_before_init":
+            step(c)
+        elif case == "count_mismatch":
+            call("fmi3GetFloat64", [V, V, S, V, S], c, arr(U, vr["u"], vr["delta"]), 2, arr(D, 0, 0), 1)
+        elif case == "null_arrays":
+            call("fmi3GetFloat64", [V, V, S, V, S], c, None, 1, None, 1)
+            call("fmi3SetFloat64", [V, V, S, V, S], c, None, 1, None, 1)
+        elif case == "unknown_vr":
+            call("fmi3GetFloat64", [V, V, S, V, S], c, arr(U, 99999), 1, arr(D, 0), 1)
+        elif case == "types_it_has_none_of":
+            for t, ct in (("Float32", ctypes.c_float), ("Int8", ctypes.c_int8), ("UInt8", ctypes.c_uint8),
+                          ("Int16", ctypes.c_int16), ("UInt16", ctypes.c_uint16), ("Int32", ctypes.c_int32),
+                          ("UInt32", ctypes.c_uint32), ("UInt64", ctypes.c_uint64), ("Boolean", ctypes.c_bool)):
+                call(f"fmi3Get{t}", [V, V, S, V, S], c, arr(U, 1), 1, arr(ct, 0), 1)
+                call(f"fmi3Set{t}", [V, V, S, V, S], c, arr(U, 1), 1, arr(ct, 0), 1)
+        elif case == "enumeration_range":
+            call("fmi3SetInt64", [V, V, S, V, S], c, arr(U, vr["preset"]), 1, arr(ctypes.c_int64, 7), 1)
+            init(c)
+            step(c)
+            read(c)
+        elif case == "enumeration_after_init":
+            init(c)
+            call("fmi3SetInt64", [V, V, S, V, S], c, arr(U, vr["preset"]), 1, arr(ctypes.c_int64, 2), 1)
+        elif case == "set_output":
+            init(c)
+            call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr["y2"]), 1, arr(D, 1.0), 1)
+        elif case in ("u_nan", "u_huge", "delta_huge", "step_negative", "step_nan"):
+            init(c)
+            if case.startswith("u_") or case == "delta_huge":
+                name = "delta" if case == "delta_huge" else "u"
+                value = {"u_nan": float("nan"), "u_huge": 1e308, "delta_huge": 1e308}[case]
+                call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr[name]), 1, arr(D, value), 1)
+                step(c)
+                call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr[name]), 1,
+                     arr(D, 22.352 if name == "u" else 0.0), 1)
+                step(c)
+            else:
+                step(c, -1.0 if case == "step_negative" else float("nan"))
+                step(c)
+            read(c)
+        elif case == "tire_scale_nan":
+            call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr["tire_scale"]), 1, arr(D, float("nan")), 1)
+            init(c)
+            step(c)
+            read(c)
+        elif case == "deserialize_garbage":
+            init(c)
+            state = V()
+            data = bytes(range(256)) * 4
+            call("fmi3DeserializeFMUState", [V, V, S, V], c, data, len(data), ctypes.byref(state))
+            call("fmi3DeserializeFMUState", [V, V, S, V], c, None, 10, ctypes.byref(state))
+            call("fmi3SetFMUState", [V, V], c, None)
+            step(c)
+        elif case == "state_round_trip":
+            init(c)
+            call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr["delta"]), 1, arr(D, 0.01), 1)
+            state = V()
+            call("fmi3GetFMUState", [V, V], c, ctypes.byref(state))
+            size = S()
+            call("fmi3SerializedFMUStateSize", [V, V, V], c, state, ctypes.byref(size))
+            buf = (ctypes.c_uint8 * size.value)()
+            call("fmi3SerializeFMUState", [V, V, V, S], c, state, buf, size.value)
+            step(c)
+            other = V()
+            call("fmi3DeserializeFMUState", [V, V, S, V], c, buf, size.value, ctypes.byref(other))
+            call("fmi3SetFMUState", [V, V], c, other)
+            call("fmi3FreeFMUState", [V, V], c, ctypes.byref(state))
+            call("fmi3FreeFMUState", [V, V], c, ctypes.byref(other))
+            step(c)
+            read(c)
+        elif case == "events_and_clocks":
+            init(c)
+            call("fmi3EnterEventMode", [V], c)
+            call("fmi3EnterStepMode", [V], c)
+            call("fmi3EnterConfigurationMode", [V], c)
+            call("fmi3GetClock", [V, V, S, V], c, arr(U, 1), 1, arr(B, False))
+            call("fmi3UpdateDiscreteStates", [V, V, V, V, V, V, V], c, None, None, None, None, None, None)
+            call("fmi3GetIntervalDecimal", [V, V, S, V, V], c, arr(U, 1), 1, arr(D, 0), arr(ctypes.c_int, 0))
+            call("fmi3GetAdjointDerivative", [V, V, S, V, S, V, S, V, S], c, arr(U, 1), 1, arr(U, 1), 1, arr(D, 1), 1,
+                 arr(D, 0), 1)
+            step(c)
+            read(c)
+        elif case == "terminate_then_step":
+            init(c)
+            call("fmi3Terminate", [V], c)
+            step(c)
+            call("fmi3Reset", [V], c)
+            init(c)
+            step(c)
+            read(c)
+        elif case == "host_hygiene":
+            init(c)
+            call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr["delta"]), 1, arr(D, 0.01), 1)
+            for _ in range(10):
+                step(c, 0.1)
+            out = arr(D, 0.0)
+            call("fmi3GetFloat64", [V, V, S, V, S], c, arr(U, vr["r1"]), 1, out, 1)
+            records.append((0, f"r1={out[0]!r}"))
+        else:
+            raise SystemExit(f"unknown case {case}")
+    if c:
+        free(c)
+    after = {"path": list(sys.path), "meta": [repr(f) for f in sys.meta_path]}
+    changed = {k: [x for x in after[k] if x not in before[k]] for k in before}
+    print(json.dumps({"status": statuses, "messages": [m for s, m in records if s in (1, 3, 4) or m.startswith("r1=")],
+                      "fatal": any(s == 4 for s, _m in records) or 4 in statuses, "finite": finite[0],
+                      "changed": changed}))
+    print("survived")
+
+
+if __name__ == "__main__":
+    main()
