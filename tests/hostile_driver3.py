@@ -106,6 +106,32 @@ def main():
             call("fmi3EnterInitializationMode", [V, B, D, D, B, D], c, False, 0.0, 0.0, False, 0.0)
             call("fmi3ExitInitializationMode", [V], c)
             call("fmi3DoStep", [V, D, D, B, V, V, V, V], c, 0.0, 0.01, True, None, None, None, None)
+    elif case == "model_exchange_calls":   # the native FMU's Model Exchange entry points
+        me = fn("fmi3InstantiateModelExchange", V, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_bool,
+                ctypes.c_bool, V, LOG)
+        c = me(b"h", token, resources, False, logging, None, log)
+        assert c, records
+        n = S()
+        call("fmi3GetNumberOfContinuousStates", [V, V], c, ctypes.byref(n))
+        nx = n.value
+        x, dx = arr(D, *[0.0] * nx), arr(D, *[0.0] * nx)
+        init(c)                                                            # 0, 0
+        call("fmi3EnterContinuousTimeMode", [V], c)                        # 0
+        call("fmi3GetContinuousStateDerivatives", [V, V, S], c, dx, nx)    # 0
+        call("fmi3SetContinuousStates", [V, V, S], c, x, nx - 1)           # E: wrong count
+        x[1] = float("nan")
+        call("fmi3SetContinuousStates", [V, V, S], c, x, nx)               # E: not finite
+        x[1] = 0.0
+        call("fmi3GetContinuousStateDerivatives", [V, V, S], c, None, nx)  # E: null
+        call("fmi3SetTime", [V, D], c, float("nan"))                       # E: not finite
+        call("fmi3CompletedIntegratorStep", [V, B, V, V], c, True, None, None)   # E: null
+        call("fmi3DoStep", [V, D, D, B, V, V, V, V], c, 0.0, 0.1, True, None, None, None, None)  # E: ME instance
+        call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr["delta"]), 1, arr(D, 5.0), 1)        # 0
+        call("fmi3GetContinuousStateDerivatives", [V, V, S], c, dx, nx)    # E: delta outside [-1, 1]
+        call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr["delta"]), 1, arr(D, 0.01), 1)       # 0
+        call("fmi3GetContinuousStateDerivatives", [V, V, S], c, dx, nx)    # 0
+        finite[0] = all(math.isfinite(v) for v in dx[:nx])
+        read(c)                                                            # 0
     else:
         c = instantiate()
         assert c, records

@@ -49,6 +49,7 @@ PER_KIND = {
                "model_exchange_of_cs_only": ([E], "is a Co-Simulation FMU"),
                "deserialize_garbage": ([0, 0, E, E, E, 0], "not an FMU state written by this FMU")},
     "native": {"model_exchange_of_cs_only": ([0, 0, 0, E], None),
+               "model_exchange_calls": ([0, 0, 0, 0, 0, E, E, E, E, E, E, 0, E, 0, 0, 0], "states given, this FMU has 14"),
                "deserialize_garbage": ([0, 0, E, E, E, 0], "serialized FMU state of 1024 bytes: expected")},
 }
 
