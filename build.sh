@@ -44,7 +44,7 @@ python_env() {
     stamp="$VENV/.installed-$(cat pyproject.toml constraints.txt | sha1sum | cut -c1-16)"
     if [ ! -f "$stamp" ]; then
         log "installing the package and pinned dependencies into .venv"
-        "$PY" -m pip install -q -c constraints.txt -e ".[fmu,report,test]"
+        "$PY" -m pip install -q -c constraints.txt -e ".[fmu,report,study,test]"
         rm -f "$VENV"/.installed-*
         touch "$stamp"
     fi
