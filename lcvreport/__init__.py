@@ -59,6 +59,11 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``slave3``           the FMI 3.0 slave class: the core behind pythonfmu3
     ``build``            builders of the pythonfmu and the C FMU (sources in the
                          repository's ``fmu_src/``, installed as ``lcvreport.fmu_src``)
+``study/``               **studies at scale** (SPEC section 14; pandas, pyarrow, dask on use):
+    ``spec``             the study file: vehicle, factors, design, measures; the cases
+    ``compute``          the measures of a chunk of cases, batched over the cases
+    ``run``              ``lcv study``: chunks on Dask, Parquet written atomically, resume
+    ``results``          ``read_study`` (one table) and ``study_case`` (a row as a measure_set call)
 ``report/``              **the reports** (notebooks in ``notebooks/``, installed as
                          ``lcvreport.notebooks``):
     ``plotting``         figures (matplotlib), units on every axis
@@ -108,6 +113,8 @@ _API = {
     "measure_set": "analysis.measures", "rearward_amplification": "analysis.measures",
     "critical_speed": "analysis.measures", "least_damping": "analysis.measures", "single_sine": "analysis.measures",
     "trim": "analysis.measures",
+    "read_study": "study.results", "study_case": "study.results", "load_study": "study.spec",
+    "run_study": "study.run",
 }
 __all__ = sorted(_API) + ["ranges", "units"]
 

@@ -10,6 +10,7 @@ Fixed contract (other parts and outside checks call these forms)::
     lcv measures (...) [--load UNITS] --json
     lcv fmu      (--preset NAME | --vehicle FILE) --out DIR [--kind python|native|both] [--fmi 2|3]
     lcv report   (--preset NAME | --vehicle FILE) [--speed-kph V] [--load UNITS] --out DIR
+    lcv study    STUDY.toml --out DIR [--workers N | --scheduler ADDRESS] [--csv] [--json]
     lcv presets  [--json]
 
 ``UNITS`` is a comma list of unit names of the vehicle; each gets the 1 % rule on its
@@ -239,6 +240,16 @@ def build_parser() -> argparse.ArgumentParser:
                       help=f"angle of the turn [deg], in {RANGES['turn_angle'].text()}; default 90")
     turn.add_argument("--plot", metavar="FILE", help="draw the swept path into FILE (.png, .pdf or .svg; a new file)")
     turn.add_argument("--json", action="store_true", help="machine-readable output")
+    st = sub.add_parser("study", help="a study file's cases (factors, design, measures) in batches on Dask, "
+                                      "results in Parquet (SPEC 14)")
+    st.add_argument("study_file", metavar="STUDY.toml", help="the study file")
+    st.add_argument("--out", required=True, metavar="DIR", help="results folder: new, empty, or this study's "
+                                                               "earlier results (then only missing chunks run)")
+    where = st.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, metavar="N", help="a local Dask cluster of N worker processes")
+    where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (tcp://host:8786)")
+    st.add_argument("--csv", action="store_true", help="also write DIR/results.csv (one row per case)")
+    st.add_argument("--json", action="store_true", help="machine-readable summary")
     sub.add_parser("presets", help="list the presets").add_argument("--json", action="store_true")
     return p
 
@@ -850,9 +861,54 @@ def _write_figure_new(fig, path: Path) -> None:
         os.unlink(tmp)
 
 
+def _cmd_study(args, out: _Out) -> int:
+    from .study.run import run_study
+    from .study.spec import StudyError, load_study
+    try:
+        study = load_study(args.study_file)
+    except StudyError as exc:
+        raise UsageError(f"{args.study_file}: {exc}") from None
+    out_dir = Path(args.out)
+    csv_path = out_dir / "results.csv"
+    if args.csv and (csv_path.exists() or csv_path.is_symlink()):
+        raise UsageError(f"argument --csv: {csv_path} exists; lcv never overwrites a file (move it, or omit --csv)")
+    if not args.json:
+        seed = f", seed {study.seed}" if study.seed is not None else ""
+        out.line(f"study of {study.vehicle.name}: {study.kind} design{seed}, {study.n_cases} cases in "
+                 f"{study.n_chunks} chunks of {study.chunk}; measures {', '.join(study.measures)}")
+        for f in study.factors:
+            out.line(f"  {f.describe()}")
+        out.stream.flush()
+    try:
+        summary = run_study(study, out_dir, workers=args.workers, scheduler=args.scheduler)
+    except StudyError as exc:
+        raise UsageError(str(exc)) from None
+    if args.csv:
+        from .study.results import read_study
+        tmp = out_dir / ".results.csv.tmp"
+        read_study(out_dir).to_csv(tmp, index=False, float_format="%.17g")
+        try:
+            os.link(tmp, csv_path)
+        except FileExistsError:
+            raise UsageError(f"argument --csv: {csv_path} appeared meanwhile; nothing was overwritten") from None
+        finally:
+            tmp.unlink()
+    doc = {"out": str(out_dir), "n_cases": summary.n_cases, "n_chunks": summary.n_chunks,
+           "chunks_computed": summary.n_computed, "chunks_found": summary.n_found, "seconds": summary.seconds,
+           "seed": study.seed}
+    if args.json:
+        out.json(doc)
+    else:
+        rate = (summary.n_computed and summary.n_cases * summary.n_computed / summary.n_chunks / summary.seconds)
+        out.line(f"{summary.n_computed} chunks computed, {summary.n_found} found done, in {summary.seconds:.1f} s"
+                 + (f" ({rate:.0f} cases/s)" if rate else "") + f"; results in {out_dir}"
+                 + (f", {csv_path.name}" if args.csv else ""))
+    return 0
+
+
 COMMANDS = {"presets": _cmd_presets, "eig": _cmd_eig, "matrices": _cmd_matrices, "steady": _cmd_steady,
             "simulate": _cmd_simulate, "measures": _cmd_measures, "fmu": _cmd_fmu, "report": _cmd_report,
-            "tracking": _cmd_tracking, "turn": _cmd_turn}
+            "tracking": _cmd_tracking, "turn": _cmd_turn, "study": _cmd_study}
 
 
 def run(argv: Sequence[str] | None = None, out=None) -> int:

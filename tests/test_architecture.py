@@ -15,7 +15,7 @@ import lcvreport
 
 PACKAGE = Path(lcvreport.__file__).resolve().parent
 #: the layers, lowest first: a module may import its own layer and the ones before it
-LAYERS = ["units", "ranges", "util", "model", "analysis", "thesis", "fmu", "report", "cli", "_entry"]
+LAYERS = ["units", "ranges", "util", "model", "analysis", "thesis", "fmu", "study", "report", "cli", "_entry"]
 #: imports of a higher layer allowed inside a function only (never at import time):
 #: results that plot themselves (as python-control's), and the presets' optional thesis
 #: masses (``load_preset(name, masses="unrounded")``)

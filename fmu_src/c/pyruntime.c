@@ -255,7 +255,22 @@ static void bring_up(void)
     }
     python_lib = py;
     python_ready = 1;
-    if (run_python(py, "import numpy\n") != 0) {
+    /* the FMU's own interpreter runs BLAS with one thread (LCV_BLAS_THREADS, or the standard variables where
+       the host set them): OpenBLAS reads the environment when numpy loads it; the variables the FMU set are
+       taken away again, so the host's environment is as it was.  A Python host's numpy is the host's. */
+    if (run_python(py, started ?
+                   "import os\n"
+                   "names = ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS')\n"
+                   "added = [v for v in names if v not in os.environ]\n"
+                   "n = os.environ.get('LCV_BLAS_THREADS', '1').strip()\n"
+                   "n = n if n.isdigit() and int(n) >= 1 else '1'\n"
+                   "for v in added:\n"
+                   "    os.environ[v] = n\n"
+                   "try:\n"
+                   "    import numpy\n"
+                   "finally:\n"
+                   "    for v in added:\n"
+                   "        del os.environ[v]\n" : "import numpy\n") != 0) {
         snprintf(load_error, sizeof load_error, "numpy cannot be imported by the Python in this process (%s); set "
                  "LCV_FMU_SITE_PACKAGES to the site-packages of an environment that has numpy", started ?
                  "started by the FMU" : "the host's");

@@ -173,9 +173,9 @@ class VariantBatch:
 
     def _ra_at(self, speed_mps: float, f_hz: np.ndarray, tire_scale: float, rows=None) -> np.ndarray:
         """RA of variant rows[b] (default: every variant) at frequency f_hz[b, j] [Hz], shape (K, J);
-        in blocks of frequencies (the same numbers, computed in cache: 6x faster at 1000 x 381)."""
+        in blocks of frequencies (the same numbers, computed in cache, no page faults: 5x faster at 1000 x 381)."""
         J = f_hz.shape[1]
-        block = max(1, 32768 // max(1, f_hz.shape[0]))
+        block = max(1, 8192 // max(1, f_hz.shape[0]))
         if J > block:
             return np.concatenate([self._ra_at_block(speed_mps, f_hz[:, j:j + block], tire_scale, rows)
                                    for j in range(0, J, block)], axis=1)

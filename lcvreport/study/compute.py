@@ -1,0 +1,74 @@
+"""The measures of a chunk of a study's cases: batched over the cases where the measure has a
+batched form (:mod:`lcvreport.analysis.batch`), case by case with :func:`measure_set` otherwise.
+
+The cases of a chunk are grouped by speed and tire scale (the batch runs at one of each); a
+group is one :class:`~lcvreport.analysis.batch.VariantBatch`.  Undefined measures are NaN (the
+JSON's null).  Same numbers as ``lcv measures`` of each case (tests/test_study.py: 1e-12
+relative), the same numbers whichever process computes a chunk.
+
+Examples
+--------
+>>> from lcvreport.study.spec import study_from_dict
+>>> s = study_from_dict({"vehicle": "tractor_semitrailer", "speed_kph": 88.0, "measures": ["hsso_m"],
+...     "factors": {"trailer1.mass_scale": {"values": [0.8, 1.2]}}})
+>>> cols = compute_chunk(s, [0, 1])
+>>> list(cols), cols["hsso_m"].shape
+(['case_id', 'trailer1.mass_scale', 'hsso_m'], (2,))
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..analysis.batch import VariantBatch
+from ..analysis.measures import RA_FREQUENCY_HZ, measure_set
+from .spec import BATCHED, Study
+
+
+def _batched(batch: VariantBatch, speed_mps: float, tire_scale: float, wanted: set) -> dict:
+    out = {}
+    if wanted & {"least_damping_ratio", "least_damped_frequency_hz"}:
+        out["least_damping_ratio"], out["least_damped_frequency_hz"] = batch.least_damping(speed_mps, tire_scale)
+    if "critical_speed_kph" in wanted:
+        out["critical_speed_kph"] = batch.critical_speed(tire_scale)
+    if "ra_frequency" in wanted:
+        out["ra_frequency"] = batch.rearward_amplification(speed_mps, RA_FREQUENCY_HZ, tire_scale)
+    if wanted & {"ra_peak", "ra_peak_frequency_hz"}:
+        out["ra_peak"], out["ra_peak_frequency_hz"] = batch.ra_peak(speed_mps, tire_scale)
+    if wanted & {"hsso_m", "steady_turn_delta_rad"}:
+        out["hsso_m"], out["steady_turn_delta_rad"] = batch.steady_turn(speed_mps, tire_scale)
+    return out
+
+
+def compute_chunk(study: Study, case_ids) -> dict:
+    """Columns of the cases ``case_ids``: ``case_id``, every factor, every measure (float64,
+    NaN where undefined), in that order."""
+    ids = np.asarray(case_ids, dtype=np.int64)
+    table = study.factor_table(ids)
+    speeds = study.speeds_mps(table) if table else np.full(ids.size, np.nan)
+    scales = np.asarray(table.get("tire_scale", np.ones(ids.size)), dtype=float)
+    params = study.batch_parameters(table)
+    cols = {"case_id": ids}
+    cols.update({name: np.asarray(arr, dtype=float) for name, arr in table.items()})
+    for m in study.measures:
+        cols[m] = np.full(ids.size, np.nan)
+    v = study.vehicle
+    batched = set(study.measures) & set(BATCHED) if v.steered_axles else set()
+    if batched:
+        keys = np.stack([speeds, scales], axis=1)
+        groups, inverse = np.unique(keys, axis=0, return_inverse=True)
+        for g, (u, ts) in enumerate(groups):
+            rows = np.flatnonzero(inverse.ravel() == g)
+            values = {k: arr[rows] for k, arr in params.items()}
+            batch = VariantBatch(v, values)
+            for name, arr in _batched(batch, float(u), float(ts), batched).items():
+                if name in batched:
+                    cols[name][rows] = np.broadcast_to(arr, rows.shape)
+    rest = [m for m in study.measures if m not in batched]
+    if rest:
+        for k, case_id in enumerate(ids):
+            vehicle, speed_mps, kwargs = study.case(int(case_id))
+            doc = measure_set(vehicle, speed_mps, **kwargs).to_dict()
+            for m in rest:
+                value = doc.get(m)
+                cols[m][k] = np.nan if value is None else float(value)
+    return cols
