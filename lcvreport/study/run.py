@@ -170,6 +170,11 @@ def run_study(study: Study, out, workers: int | None = None, scheduler: str | No
     finally:
         if bar is not None:
             bar.close()
+        for stale in chunks.glob(".chunk-*.tmp"):   # an interrupted chunk's partial file (ours), if any
+            try:
+                stale.unlink()
+            except OSError:
+                pass
     return RunSummary(out, study.n_chunks, len(todo), found, n, time.perf_counter() - t0)
 
 

@@ -1,0 +1,237 @@
+"""``lcv study`` (issue 21, SPEC section 14): the study file, the cases, the numbers (each row
+equals measure_set of its case, recomputed independently from study_case), the same results in
+process and on two local Dask workers, resume, interruption by SIGINT and SIGKILL, and every
+refusal as one line with exit status 2 and nothing of the user's touched."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lcvreport import load_preset, measure_set, read_study, study_case
+from lcvreport.study.run import run_study
+from lcvreport.study.spec import MEASURES, StudyError, load_study, study_from_dict
+
+ROOT = Path(__file__).resolve().parents[1]
+LCV = [sys.executable, "-m", "lcvreport.cli"]
+
+SMALL = {"vehicle": "aucnat", "measures": list(MEASURES[:8]) + ["ra_single_sine", "yaw_damping_coefficient"],
+         "design": {"kind": "random", "count": 12, "seed": 7}, "chunk_size": 5,
+         "factors": {"speed_kph": {"values": [70.0, 95.0]},
+                     "trailer3.mass_scale": {"distribution": "uniform", "low": 0.6, "high": 1.1},
+                     "dolly1.yaw_inertia_scale": {"distribution": "normal", "mean": 1.0, "sd": 0.1},
+                     "21.cornering_stiffness_scale": {"distribution": "uniform", "low": 0.8, "high": 1.2},
+                     "trailer2.aligning_stiffness_scale": {"values": [0.9, 1.1]},
+                     "tire_scale": {"values": [0.9, 1.0]}}}
+
+
+def _toml(doc: dict) -> str:
+    def val(x):
+        if isinstance(x, str):
+            return json.dumps(x)
+        if isinstance(x, list):
+            return "[" + ", ".join(val(v) for v in x) + "]"
+        if isinstance(x, dict):
+            return "{ " + ", ".join(f"{json.dumps(k)} = {val(v)}" for k, v in x.items()) + " }"
+        return repr(x)
+    lines = [f"{k} = {val(v)}" for k, v in doc.items() if not isinstance(v, dict)]
+    for table in ("design", "factors"):
+        if table in doc:
+            lines.append(f"[{table}]")
+            lines += [f"{json.dumps(k)} = {val(v)}" for k, v in doc[table].items()]
+    return "\n".join(lines) + "\n"
+
+
+def _write(tmp_path: Path, doc: dict, name: str = "study.toml") -> Path:
+    p = tmp_path / name
+    p.write_text(_toml(doc), encoding="utf-8")
+    return p
+
+
+def _close(a, b, rel=1e-12):
+    if a is None or (isinstance(a, float) and math.isnan(a)):
+        return b is None or (isinstance(b, float) and math.isnan(b))
+    return b is not None and abs(a - b) <= rel * max(abs(a), abs(b), 1e-300)
+
+
+def test_every_row_is_measure_set_of_its_case(tmp_path):
+    """Batched and case-by-case measures, every kind of factor: each row equals measure_set of
+    the case study_case gives (the vehicle rebuilt with the scaled values), to 1e-12 relative."""
+    study = study_from_dict(SMALL)
+    run_study(study, tmp_path / "out")
+    table = read_study(tmp_path / "out")
+    assert list(table["case_id"]) == list(range(12))
+    assert list(table.columns) == ["case_id", *SMALL["factors"], *SMALL["measures"]]
+    base = load_preset("aucnat")
+    for _, row in table.iterrows():
+        vehicle, speed_mps, kwargs = study_case(tmp_path / "out", int(row["case_id"]))
+        assert math.isclose(speed_mps * 3.6, row["speed_kph"], rel_tol=1e-15)
+        assert vehicle.units[5].mass_kg == pytest.approx(base.units[5].mass_kg * row["trailer3.mass_scale"],
+                                                         rel=1e-15)
+        assert kwargs == {"tire_scale": row["tire_scale"]}
+        doc = measure_set(vehicle, speed_mps, **kwargs).to_dict()
+        for m in SMALL["measures"]:
+            # where a smooth maximum lies is known to about sqrt(eps) of its frequency, by the batch's
+            # golden section and measure_set's Brent method alike (tests/test_batch.py); values to 1e-12
+            rel = 1e-6 if m == "ra_peak_frequency_hz" else 1e-12
+            assert _close(row[m], doc[m], rel), (int(row["case_id"]), m, row[m], doc[m])
+
+
+def test_grid_order_and_design_reproducibility():
+    s = study_from_dict({"vehicle": "tractor_semitrailer", "speed_kph": 88.0, "measures": ["hsso_m"],
+                         "factors": {"trailer1.mass_scale": {"values": [0.8, 1.0, 1.2]},
+                                     "tire_scale": {"values": [0.9, 1.1]}}})
+    t = s.factor_table(range(6))
+    assert t["trailer1.mass_scale"].tolist() == [0.8, 0.8, 1.0, 1.0, 1.2, 1.2]        # the last factor fastest
+    assert t["tire_scale"].tolist() == [0.9, 1.1] * 3
+    a = study_from_dict(SMALL).factor_table(range(12))
+    b = study_from_dict(SMALL).factor_table(range(12))
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+    rng = np.random.default_rng(7)                     # the documented draw order: factor by factor
+    assert np.array_equal(a["speed_kph"], np.array([70.0, 95.0])[rng.integers(0, 2, 12)])
+    assert np.array_equal(a["trailer3.mass_scale"], rng.uniform(0.6, 1.1, 12))
+
+
+def test_two_local_workers_give_the_in_process_results_bit_for_bit(tmp_path):
+    doc = dict(SMALL, measures=list(MEASURES[:8]), design={"kind": "random", "count": 60, "seed": 11},
+               chunk_size=10)
+    study = study_from_dict(doc)
+    run_study(study, tmp_path / "a")
+    run_study(study, tmp_path / "b", workers=2)
+    a, b = read_study(tmp_path / "a"), read_study(tmp_path / "b")
+    assert a.equals(b)
+    assert a[MEASURES[:8][0]].notna().all()
+
+
+def test_a_rerun_computes_only_the_missing_chunks(tmp_path):
+    study = study_from_dict(dict(SMALL, measures=["hsso_m", "ra_frequency"]))
+    first = run_study(study, tmp_path / "out")
+    assert (first.n_chunks, first.n_computed) == (3, 3)
+    before = read_study(tmp_path / "out")
+    victim = tmp_path / "out" / "chunks" / "chunk-000001.parquet"
+    kept = (tmp_path / "out" / "chunks" / "chunk-000000.parquet").stat().st_mtime_ns
+    victim.unlink()
+    with pytest.raises(StudyError, match="1 of 3 chunks are missing"):
+        read_study(tmp_path / "out")
+    again = run_study(study, tmp_path / "out")
+    assert (again.n_computed, again.n_found) == (1, 2)
+    assert (tmp_path / "out" / "chunks" / "chunk-000000.parquet").stat().st_mtime_ns == kept
+    assert read_study(tmp_path / "out").equals(before)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL], ids=["SIGINT", "SIGKILL"])
+@pytest.mark.parametrize("workers", [None, 2], ids=["in-process", "2-workers"])
+def test_an_interrupted_study_loses_no_finished_chunk_and_the_rerun_completes_it(tmp_path, sig, workers):
+    doc = dict(SMALL, measures=["least_damping_ratio", "critical_speed_kph", "ra_peak"],
+               design={"kind": "random", "count": 1200, "seed": 3}, chunk_size=40)
+    path = _write(tmp_path, doc)
+    out = tmp_path / "out"
+    cmd = LCV + ["study", str(path), "--out", str(out)] + (["--workers", str(workers)] if workers else [])
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    chunks = out / "chunks"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        if chunks.exists() and len(list(chunks.glob("chunk-*.parquet"))) >= 3:
+            break
+        time.sleep(0.05)
+    assert p.poll() is None, "the study ended before it could be interrupted: make it longer"
+    p.send_signal(sig)
+    _, err = p.communicate(timeout=60)
+    if sig == signal.SIGINT:
+        assert p.returncode == 130 and err.strip().splitlines()[-1] == "lcv: interrupted", err
+        assert "Traceback" not in err
+    if workers:                                  # orphaned workers of a killed run may still finish a chunk
+        time.sleep(2.0)
+    done = sorted(chunks.glob("chunk-*.parquet"))
+    assert 3 <= len(done) < 30
+    assert not list(chunks.glob(".*.tmp")) or sig == signal.SIGKILL   # SIGINT leaves no partial file
+    import pyarrow.parquet as pq
+    for f in done:                                # every file under a final name is whole
+        assert pq.read_table(f).num_rows == 40
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(out), "--json"], capture_output=True, text=True,
+                       cwd=tmp_path, timeout=600)
+    assert r.returncode == 0, r.stderr
+    summary = json.loads(r.stdout)
+    assert summary["chunks_found"] >= len(done) - 1 and summary["chunks_computed"] + summary["chunks_found"] == 30
+    table = read_study(out)
+    assert table["case_id"].tolist() == list(range(1200))          # every case exactly once
+    assert not list(chunks.glob(".*.tmp"))
+
+
+BAD = [
+    ({"vehicle": "nope"}, "vehicle: 'nope' is neither a preset"),
+    ({"measures": ["ra_peek"]}, "measures: 'ra_peek' is not a measure"),
+    ({"design": {"kind": "latin"}}, "design.kind must be grid or random"),
+    ({"design": {"kind": "random", "count": 0, "seed": 1}}, "design.count must be an integer in [1, 10000000]"),
+    ({"design": {"kind": "random", "count": 10}}, "design.seed must be an integer >= 0"),
+    ({"factors": {"trailer9.mass_scale": {"values": [1.0]}}}, "factors.trailer9.mass_scale: unknown factor"),
+    ({"factors": {"speed_kph": {"values": [80.0, -1.0]}}}, "factors.speed_kph.values[1] must be a finite number > 0"),
+    ({"factors": {"speed_kph": {"distribution": "uniform", "low": 90.0, "high": 80.0}}}, "low must be below high"),
+    ({"factors": {"trailer1.mass_scale": {"distribution": "normal", "mean": 1.0, "sd": 0.6}},
+      "design": {"kind": "random", "count": 1000, "seed": 1}, "speed_kph": 88.0}, "every value must be > 0"),
+    ({"factors": {"speed_kph": {"distribution": "normal", "mean": 88.0, "sd": 1.0}}},
+     "a grid design needs values = [...]"),
+    ({"factors": {"speed_kph": {"values": [88.0], "step": 1}}}, "unknown key 'step'"),
+    ({"colour": "red"}, "unknown key 'colour'"),
+]
+
+
+@pytest.mark.parametrize("change,fragment", BAD, ids=[f"bad{k}" for k in range(len(BAD))])
+def test_a_bad_study_file_is_one_line_and_exit_2(tmp_path, change, fragment):
+    doc = {"vehicle": "aucnat", "measures": ["hsso_m"], "design": {"kind": "grid"},
+           "factors": {"speed_kph": {"values": [80.0]}}}
+    doc.update(change)
+    path = _write(tmp_path, doc)
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "out")], capture_output=True, text=True,
+                       cwd=tmp_path)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and fragment in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_refusals_never_touch_a_users_files(tmp_path):
+    path = _write(tmp_path, dict(SMALL, measures=["hsso_m"]))
+    other = _write(tmp_path, dict(SMALL, measures=["ra_frequency"]), "other.toml")
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep me")
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(mine)], capture_output=True, text=True)
+    assert r.returncode == 2 and "holds files that are not a study's results" in r.stderr
+    assert [p.name for p in mine.iterdir()] == ["notes.txt"]
+    out = tmp_path / "out"
+    assert subprocess.run(LCV + ["study", str(path), "--out", str(out), "--csv"], capture_output=True).returncode == 0
+    csv_before = (out / "results.csv").read_bytes()
+    r = subprocess.run(LCV + ["study", str(other), "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 2 and "holds the results of another study" in r.stderr
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(out), "--csv"], capture_output=True, text=True)
+    assert r.returncode == 2 and "results.csv exists" in r.stderr
+    assert (out / "results.csv").read_bytes() == csv_before
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(out), "--workers", "2", "--scheduler", "tcp://x:1"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "not allowed with argument" in r.stderr
+    r = subprocess.run(LCV + ["study", str(tmp_path / "missing.toml"), "--out", str(tmp_path / "o2")],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "does not exist" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_the_csv_is_the_table(tmp_path):
+    import pandas as pd
+    path = _write(tmp_path, dict(SMALL, measures=["hsso_m", "ra_peak"]))
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "out"), "--csv"], capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    a = read_study(tmp_path / "out")
+    b = pd.read_csv(tmp_path / "out" / "results.csv")
+    assert list(a.columns) == list(b.columns) and np.array_equal(a.to_numpy(), b.to_numpy(), equal_nan=True)
+
+
+def test_the_example_study_parses():
+    s = load_study(ROOT / "examples" / "studies" / "aucnat_loads.toml")
+    assert s.n_cases == 10_000 and s.seed == 20261130 and s.n_chunks * s.chunk >= s.n_cases
