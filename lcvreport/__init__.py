@@ -64,6 +64,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``compute``          the measures of a chunk of cases, batched over the cases
     ``run``              ``lcv study``: chunks on Dask, Parquet written atomically, resume
     ``results``          ``read_study`` (one table) and ``study_case`` (a row as a measure_set call)
+    ``summary``          spread of the measures, pass rates against criteria (the study report)
 ``report/``              **the reports** (notebooks in ``notebooks/``, installed as
                          ``lcvreport.notebooks``):
     ``plotting``         figures (matplotlib), units on every axis

@@ -10,7 +10,7 @@ Fixed contract (other parts and outside checks call these forms)::
     lcv measures (...) [--load UNITS] --json
     lcv fmu      (--preset NAME | --vehicle FILE) --out DIR [--kind python|native|both] [--fmi 2|3]
     lcv report   (--preset NAME | --vehicle FILE) [--speed-kph V] [--load UNITS] --out DIR
-    lcv study    STUDY.toml --out DIR [--workers N | --scheduler ADDRESS] [--csv] [--json]
+    lcv study    STUDY.toml --out DIR [--workers N | --scheduler ADDRESS] [--csv] [--report R [--criteria F]]
     lcv presets  [--json]
 
 ``UNITS`` is a comma list of unit names of the vehicle; each gets the 1 % rule on its
@@ -249,6 +249,10 @@ def build_parser() -> argparse.ArgumentParser:
     where.add_argument("--workers", type=int, metavar="N", help="a local Dask cluster of N worker processes")
     where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (tcp://host:8786)")
     st.add_argument("--csv", action="store_true", help="also write DIR/results.csv (one row per case)")
+    st.add_argument("--report", metavar="REPORT_DIR", help="then write the study report (HTML, PDF) into REPORT_DIR: "
+                                                           "new, empty or an earlier report")
+    st.add_argument("--criteria", metavar="FILE", help="with --report: limits to judge the cases by (TOML)")
+    st.add_argument("--no-pdf", action="store_true", help="with --report: HTML only")
     st.add_argument("--json", action="store_true", help="machine-readable summary")
     sub.add_parser("presets", help="list the presets").add_argument("--json", action="store_true")
     return p
@@ -869,6 +873,22 @@ def _cmd_study(args, out: _Out) -> int:
     except StudyError as exc:
         raise UsageError(f"{args.study_file}: {exc}") from None
     out_dir = Path(args.out)
+    if (args.criteria is not None or args.no_pdf) and args.report is None:
+        raise UsageError("arguments --criteria and --no-pdf belong to --report REPORT_DIR")
+    if args.report is not None:
+        from .report.build import OutputFolderError, check_output_folder
+        try:
+            check_output_folder(args.report)
+        except OutputFolderError as exc:
+            raise UsageError(f"argument --report: {exc}") from None
+        if Path(args.report).resolve() == out_dir.resolve():
+            raise UsageError("argument --report: give another folder than --out")
+    if args.criteria is not None:
+        from .analysis.criteria import CriteriaError, load_criteria
+        try:
+            load_criteria(args.criteria)
+        except CriteriaError as exc:
+            raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
     csv_path = out_dir / "results.csv"
     if args.csv and (csv_path.exists() or csv_path.is_symlink()):
         raise UsageError(f"argument --csv: {csv_path} exists; lcv never overwrites a file (move it, or omit --csv)")
@@ -893,12 +913,28 @@ def _cmd_study(args, out: _Out) -> int:
             raise UsageError(f"argument --csv: {csv_path} appeared meanwhile; nothing was overwritten") from None
         finally:
             tmp.unlink()
+    report = None
+    if args.report is not None:
+        from .report.build import OutputFolderError, ReportError, build_study_report
+        try:
+            report = build_study_report(out_dir, args.report, criteria_file=args.criteria, pdf=not args.no_pdf,
+                                        progress=lambda text: print(f"lcv study: report: {text}", file=sys.stderr,
+                                                                    flush=True))
+        except OutputFolderError as exc:
+            raise UsageError(f"argument --report: {exc}") from None
+        except ReportError as exc:
+            raise OutputError(str(exc)) from None
     doc = {"out": str(out_dir), "n_cases": summary.n_cases, "n_chunks": summary.n_chunks,
            "chunks_computed": summary.n_computed, "chunks_found": summary.n_found, "seconds": summary.seconds,
            "seed": study.seed}
+    if report is not None:
+        doc["report"] = {k: str(v) for k, v in report.items() if k != "seconds"}
     if args.json:
         out.json(doc)
     else:
+        for key in ("html", "pdf"):
+            if report is not None and key in report:
+                out.line(f"wrote {report[key]}")
         rate = (summary.n_computed and summary.n_cases * summary.n_computed / summary.n_chunks / summary.seconds)
         out.line(f"{summary.n_computed} chunks computed, {summary.n_found} found done, in {summary.seconds:.1f} s"
                  + (f" ({rate:.0f} cases/s)" if rate else "") + f"; results in {out_dir}"

@@ -23,7 +23,7 @@ LAZY_UPWARD = {
     ("analysis.measures", "report.plotting"), ("analysis.response", "report.plotting"),
     ("analysis.exact", "report.plotting"), ("analysis.tracking", "report.plotting"),
     ("thesis.studies", "report.plotting"), ("thesis.tracking_questions", "report.plotting"),
-    ("analysis.low_speed_turn", "report.plotting"),
+    ("analysis.low_speed_turn", "report.plotting"), ("study.summary", "report.plotting"),
     ("model.presets", "thesis.vehicles"),
 }
 

@@ -235,3 +235,29 @@ def test_the_csv_is_the_table(tmp_path):
 def test_the_example_study_parses():
     s = load_study(ROOT / "examples" / "studies" / "aucnat_loads.toml")
     assert s.n_cases == 10_000 and s.seed == 20261130 and s.n_chunks * s.chunk >= s.n_cases
+
+
+def test_the_study_report(tmp_path):
+    """lcv study --report: the factors, the spread, the scatter, the pass rates (HTML here; the
+    PDF is built by the same exporter as the assessment report's, tested there)."""
+    crit = tmp_path / "limits.toml"
+    crit.write_text('[limits]\nhsso_m = { max = 0.05, source = "test limit" }\n'
+                    'ra_peak = { max = 9.0, source = "test limit" }\n')
+    path = _write(tmp_path, dict(SMALL, measures=["hsso_m", "ra_peak", "critical_speed_kph"],
+                                 design={"kind": "random", "count": 60, "seed": 5}, chunk_size=20))
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "out"), "--report", str(tmp_path / "rep"),
+                              "--criteria", str(crit), "--no-pdf"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    html = (tmp_path / "rep" / "index.html").read_text()
+    for fragment in ("Table S-1", "Table S-2", "Figure S-1", "Table S-3", "Figure S-2", "all of the above"):
+        assert fragment in html, fragment
+    table = read_study(tmp_path / "out")
+    passed = int(((table["hsso_m"] <= 0.05) & (table["ra_peak"] <= 9.0)).sum())
+    import csv
+    rows = list(csv.DictReader(open(tmp_path / "rep" / "data" / "table_S-3.csv")))
+    assert int(rows[-1]["passed"]) == passed and int(rows[-1]["judged"]) == 60
+    (tmp_path / "rep2").mkdir()
+    (tmp_path / "rep2" / "mine.txt").write_text("keep")
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "out"), "--report", str(tmp_path / "rep2")],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "--report" in r.stderr and (tmp_path / "rep2" / "mine.txt").read_text() == "keep"

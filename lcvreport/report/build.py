@@ -195,7 +195,20 @@ ASSESSMENT = NotebookSpec("assessment", "assessment", "Yaw-plane assessment",
                            "source": _text_or_none, "residuals": _residuals, "criteria_file": _text_or_none,
                            "tracking": _tracking,
                            "speed_kph": _speed(1 / MPS_PER_KPH, "km/h"), "load_units": _load_units})
-SPECS = {s.stem: s for s in NOTEBOOKS + (ASSESSMENT,)}
+def _study_dir(name, value, _ctx):
+    from ..study.spec import StudyError
+    from ..study.results import stored_study
+    if not isinstance(value, str):
+        raise ReportError(f"parameter {name} must be the --out folder of lcv study, got {value!r}")
+    try:
+        stored_study(value)
+    except StudyError as exc:
+        raise ReportError(f"parameter {name}: {exc}") from None
+
+
+#: the study report's notebook
+STUDY = NotebookSpec("study", "study", "Study", {**_COMMON, "study_dir": _study_dir, "criteria_file": _text_or_none})
+SPECS = {s.stem: s for s in NOTEBOOKS + (ASSESSMENT, STUDY)}
 
 
 def check_notebook_parameters(stem: str, values: dict, strict: bool = True) -> None:
@@ -651,6 +664,74 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
     res = {key: out / name for key, name in written.items()}
     res["seconds"] = time.perf_counter() - t0
     del html
+    return res
+
+
+def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf: bool = True,
+                       fast: bool = False, paper: str = "letter",
+                       progress: Callable[[str], None] | None = None) -> dict:
+    """The report of a study's results (``lcv study ... --report DIR``): its factors, the spread
+    of each measure, each measure against each factor, and pass rates against ``criteria_file``.
+    Written aside and moved into place whole, as :func:`build_assessment`; ``out_dir`` must be
+    new, empty or an earlier report.
+
+    Returns
+    -------
+    dict
+        ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
+    """
+    import json
+    import os
+    import tempfile
+    from importlib.metadata import version
+    from ..study.results import read_study, stored_study
+    from ..study.spec import StudyError
+    __version__ = version("lcvreport")
+    if paper not in PAPERS:
+        raise OutputFolderError(f"paper must be one of {', '.join(PAPERS)}, got {paper!r}")
+    progress = progress or (lambda _text: None)
+    study_dir = Path(study_dir).resolve()
+    try:
+        study = stored_study(study_dir)
+        read_study(study_dir)                     # complete, readable: before anything is written
+    except StudyError as exc:
+        raise ReportError(str(exc)) from None
+    out = check_output_folder(out_dir)
+    before = _folder_state(out)
+    staged = Path(tempfile.mkdtemp(prefix=f".{out.name}.writing-", dir=out.parent))
+    try:
+        data_dir = staged / "data"
+        data_dir.mkdir()
+        params = {"fast": bool(fast), "data_dir": str(data_dir), "study_dir": str(study_dir),
+                  "criteria_file": None if criteria_file is None else str(Path(criteria_file).resolve())}
+        t0 = time.perf_counter()
+        nb_dir = staged / "notebooks"
+        nb_dir.mkdir()
+        path = execute("study", nb_dir, params)
+        progress(f"notebook study: {time.perf_counter() - t0:.1f} s")
+        title = f"Study of {study.vehicle.name}: {study.n_cases} cases"
+        stamp = time.strftime("%Y-%m-%d", time.gmtime(int(os.environ.get("SOURCE_DATE_EPOCH", time.time()))))
+        intro = (f"The results of `lcv study` in {study_dir.name}: {study.n_cases} cases of *{study.vehicle.name}*, "
+                 f"measures {', '.join(study.measures)} (SI units; speeds in km/h). Written by lcvreport "
+                 f"{__version__} on {stamp}.")
+        nb = merge([("study", "study", title, path)], title, intro)
+        export_html(nb, staged)
+        progress("html written")
+        written = {"html": "index.html", "data": "data"}
+        if pdf:
+            export_pdf(nb, staged, f"lcvreport {__version__} study of {study.vehicle.name}", paper=paper,
+                       title_page=False)
+            written["pdf"] = "report.pdf"
+            progress("pdf written")
+        files = sorted(p.name for p in staged.iterdir()) + [MANIFEST]
+        (staged / MANIFEST).write_text(json.dumps({"written_by": f"lcvreport {__version__} (lcv study --report)",
+                                                   "files": files}, indent=1), encoding="utf-8")
+        _publish(staged, out, before)
+    except BaseException:
+        shutil.rmtree(staged, ignore_errors=True)
+        raise
+    res = {key: out / name for key, name in written.items()}
+    res["seconds"] = time.perf_counter() - t0
     return res
 
 

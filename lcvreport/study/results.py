@@ -62,13 +62,18 @@ def read_study(folder, complete: bool = True):
     return table[man["columns"]].sort_values("case_id", kind="stable").reset_index(drop=True)
 
 
-def study_case(folder, case_id: int):
-    """``(vehicle, speed_mps, kwargs)`` of row ``case_id``: ``measure_set(vehicle, speed_mps,
-    **kwargs)`` recomputes that row alone."""
+def stored_study(folder):
+    """The :class:`~lcvreport.study.spec.Study` whose results are in ``folder`` (as it was run)."""
     folder = Path(folder)
     _manifest(folder)
     try:
         doc = json.loads((folder / STUDY).read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
         raise StudyError(f"{folder / STUDY} cannot be read: {exc}") from None
-    return study_from_stored(doc).case(int(case_id))
+    return study_from_stored(doc)
+
+
+def study_case(folder, case_id: int):
+    """``(vehicle, speed_mps, kwargs)`` of row ``case_id``: ``measure_set(vehicle, speed_mps,
+    **kwargs)`` recomputes that row alone."""
+    return stored_study(folder).case(int(case_id))

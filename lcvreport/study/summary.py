@@ -1,0 +1,115 @@
+"""What a study's table says: the spread of each measure, and how many cases pass a criteria
+file's limits -- overall and along each factor (the study report's tables; drawing is in
+:mod:`lcvreport.report.plotting`).
+
+Examples
+--------
+>>> import pandas as pd
+>>> from lcvreport.analysis.criteria import Criteria, Limit
+>>> t = pd.DataFrame({"case_id": [0, 1, 2, 3], "speed_kph": [80.0, 80.0, 100.0, 100.0],
+...                   "hsso_m": [0.1, 0.2, 0.4, None]})
+>>> quantile_rows(t, ["hsso_m"])[0]["undefined"]
+1
+>>> p = pass_rates(t, Criteria({"hsso_m": Limit("hsso_m", None, 0.3, "example", False)}), ["speed_kph"])
+>>> p.overall[0]["passed"], p.overall[0]["judged"]
+(2, 3)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+QUANTILES = (0.0, 0.05, 0.5, 0.95, 1.0)
+
+
+def quantile_rows(table, measures) -> list[dict]:
+    """Per measure: cases with a value, undefined (null) cases, and its 0/5/50/95/100 % quantiles."""
+    rows = []
+    for m in measures:
+        x = table[m].to_numpy(dtype=float)
+        ok = x[np.isfinite(x)]
+        row = {"measure": m, "cases": int(ok.size), "undefined": int(x.size - ok.size)}
+        for q in QUANTILES:
+            row[f"q{int(q * 100)}"] = float(np.quantile(ok, q)) if ok.size else math.nan
+        rows.append(row)
+    return rows
+
+
+def wilson(passed: int, n: int, z: float = 1.959963984540054) -> tuple:
+    """The Wilson score 95 % interval of a pass rate ``passed / n``."""
+    if n == 0:
+        return math.nan, math.nan
+    p = passed / n
+    d = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / d
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return max(0.0, c - h), min(1.0, c + h)
+
+
+def _passes(values: np.ndarray, limit) -> np.ndarray:
+    v = np.abs(values) if limit.absolute else values
+    ok = np.ones(v.shape, bool)
+    if limit.min is not None:
+        ok &= v >= limit.min
+    if limit.max is not None:
+        ok &= v <= limit.max
+    return ok
+
+
+@dataclass
+class PassRates:
+    """Pass rates of a study against limits: ``overall`` rows (per limit and all together) and
+    ``by_factor[factor]`` = (bin centres, {limit key or "all": pass rate per bin})."""
+
+    overall: list
+    by_factor: dict
+
+    def plot(self):
+        from ..report.plotting import study_pass_rates
+        return study_pass_rates(self)
+
+
+def pass_rates(table, criteria, factors, bins: int = 8) -> PassRates:
+    """Judge every case by every limit of ``criteria`` whose measure the table has: pass, fail,
+    or not judged (the measure undefined).  Along each factor: the pass rate in ``bins`` bins of
+    equal count (or per value, for a factor of few values)."""
+    limits = [lim for key, lim in criteria.limits.items() if key in table.columns]
+    verdict = {}
+    overall = []
+    judged_all = np.ones(len(table), bool)
+    pass_all = np.ones(len(table), bool)
+    for lim in limits:
+        x = table[lim.key].to_numpy(dtype=float)
+        judged = np.isfinite(x)
+        ok = judged & _passes(np.where(judged, x, 0.0), lim)
+        verdict[lim.key] = (judged, ok)
+        judged_all &= judged
+        pass_all &= ok
+        lo, hi = wilson(int(ok.sum()), int(judged.sum()))
+        overall.append({"limit": lim.text(), "judged": int(judged.sum()), "passed": int(ok.sum()),
+                        "pass_rate": ok.sum() / judged.sum() if judged.sum() else math.nan, "ci95_low": lo,
+                        "ci95_high": hi, "source": lim.source})
+    if len(limits) > 1:
+        lo, hi = wilson(int(pass_all.sum()), int(judged_all.sum()))
+        overall.append({"limit": "all of the above", "judged": int(judged_all.sum()), "passed": int(pass_all.sum()),
+                        "pass_rate": pass_all.sum() / judged_all.sum() if judged_all.sum() else math.nan,
+                        "ci95_low": lo, "ci95_high": hi, "source": ""})
+        verdict["all"] = (judged_all, pass_all)
+    by_factor = {}
+    for f in factors:
+        x = table[f].to_numpy(dtype=float)
+        distinct = np.unique(x)
+        if distinct.size <= bins:
+            centres, which = distinct, np.searchsorted(distinct, x)
+        else:
+            edges = np.quantile(x, np.linspace(0, 1, bins + 1))
+            which = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, bins - 1)
+            centres = np.array([np.median(x[which == b]) if np.any(which == b) else np.nan for b in range(bins)])
+        rates = {}
+        for key, (judged, ok) in verdict.items():
+            rates[key] = np.array([ok[(which == b) & judged].sum() / max(1, ((which == b) & judged).sum())
+                                   if ((which == b) & judged).any() else np.nan for b in range(centres.size)])
+        by_factor[f] = (centres, rates)
+    return PassRates(overall, by_factor)
