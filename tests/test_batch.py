@@ -150,3 +150,20 @@ def test_the_measures_table_has_the_measure_set_numbers():
         assert table[key][1] == pytest.approx(m[key], rel=1e-11), key
     assert (np.isnan(table["critical_speed_kph"][1]) and m["critical_speed_kph"] is None) or \
         table["critical_speed_kph"][1] == m["critical_speed_kph"]
+
+
+def test_ra_peak_does_not_depend_on_the_batch_or_the_scan(monkeypatch):
+    """Each variant's search stops on its own: a variant's peak is the same bit for bit in any
+    batch; and the modal scan (which only picks the bracket) gives what the exact scan gives."""
+    import lcvreport.analysis.batch as batch_module
+    v = load_preset("aucnat")
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(5)
+    values = {n: _nominal(v, n) * rng.uniform(0.7, 1.3, 9) for n in names}
+    whole = VariantBatch(v, values).ra_peak(22.0)
+    for part in (slice(0, 1), slice(2, 7), slice(8, 9)):
+        sub = VariantBatch(v, {n: a[part] for n, a in values.items()}).ra_peak(22.0)
+        assert np.array_equal(sub[0], whole[0][part]) and np.array_equal(sub[1], whole[1][part])
+    monkeypatch.setattr(batch_module, "SCAN_COND_MAX", 0.0)             # every variant: the exact scan
+    exact = VariantBatch(v, values).ra_peak(22.0)
+    assert np.array_equal(exact[0], whole[0]) and np.array_equal(exact[1], whole[1])
