@@ -301,13 +301,24 @@ int model_do_step(ModelInstance *c, double h)
                  "step is refused and the state is unchanged", u, h);
         return -1;
     }
-    double znew[LCV_MAX_M];
+    double znew[LCV_MAX_M], x[LCV_MAX_M + LCV_N_INPUTS];
+    memcpy(x, c->s.z, sizeof(double) * (size_t)m);              /* [z, w]: one contiguous dot per row */
+    memcpy(x + m, c->s.w, sizeof(double) * LCV_N_INPUTS);
     for (int i = 0; i < m; ++i) {
         const double *row = K + (size_t)i * ld;
-        double s = 0.0;
-        for (int j = 0; j < m; ++j) s += row[j] * c->s.z[j];
-        for (int j = 0; j < LCV_N_INPUTS; ++j) s += row[m + j] * c->s.w[j];
-        s += step->gc[i];
+        /* four independent accumulators: the additions of a row overlap instead of waiting on
+           each other (one serial chain was latency-bound); a fixed order, so results are
+           reproducible and differ from the serial sum by rounding only */
+        double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+        int j = 0;
+        for (; j + 4 <= ld; j += 4) {
+            s0 += row[j] * x[j];
+            s1 += row[j + 1] * x[j + 1];
+            s2 += row[j + 2] * x[j + 2];
+            s3 += row[j + 3] * x[j + 3];
+        }
+        for (; j < ld; ++j) s0 += row[j] * x[j];
+        double s = ((s0 + s1) + (s2 + s3)) + step->gc[i];
         if (!isfinite(s)) {
             double e = 0.0;
             int ok = max_real_eig(c, u, &e) == 0;
