@@ -360,8 +360,8 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
         fs = float(np.r_[1.0, steered_point(vehicle)] @ (co.state_derivative_maps(u, tire_scale)[1] @ F)[:2])
     # signal rows over [x, psi1, Y1] (before the input's own part): states, psi1, Y1, ay, a_steer, Y_axles, Theta
     names = list(vehicle.state_names) + ["psi1", "Y1"]
-    base = [np.eye(m)[i] for i in range(m)]
-    V_ay = [np.r_[Ca[i], 0.0, 0.0] for i in range(nu)]
+    V_ay = np.zeros((nu, m))
+    V_ay[:, :n] = Ca
     names_ay = [f"ay{i + 1}" for i in range(nu)]
     xs = steered_point(vehicle) if vehicle.steered_axles else None
     Y_rows, Y_names = [], []
@@ -413,25 +413,24 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
         else:
             d_row = np.zeros(dim)
             d_row[m:m + p] = piece.h
-        rows = [d_row]
-        for r in base:
-            rows.append(np.r_[r, np.zeros(p + 1)])
-        for i in range(nu):
-            row = np.r_[V_ay[i], np.zeros(p + 1)] + da[i] * d_row
-            row[-1] += aF[i]
-            rows.append(row)
+        # rows: the steer, the states and psi1, Y1, ay of every unit, a_steer, Y of every axle, Theta
+        C = np.zeros((1 + m + nu + 1 + len(Y_rows) + nu - 1, dim))
+        C[0] = d_row
+        C[1:1 + m, :m] = np.eye(m)
+        r0 = 1 + m
+        C[r0:r0 + nu, :m] = V_ay
+        C[r0:r0 + nu] += np.outer(da, d_row)
+        C[r0:r0 + nu, -1] += aF
+        r0 += nu
         if xs is not None:
             # a_s = v1' + x_s r1' + u r1: from the state derivative
-            a_row = (np.r_[1.0, xs, np.zeros(dim - 2)]) @ Mz
-            a_row[1] += u
-            rows.append(a_row)
-        else:
-            rows.append(np.zeros(dim))
-        for r in Y_rows:
-            rows.append(np.r_[r, np.zeros(p + 1)])
-        for k in range(nu - 1):
-            rows.append(np.r_[cum[k], np.zeros(p + 1)])
-        C = np.array(rows)
+            C[r0] = Mz[0] + xs * Mz[1]
+            C[r0, 1] += u
+        r0 += 1
+        if Y_rows:
+            C[r0:r0 + len(Y_rows), :m] = Y_rows
+        r0 += len(Y_rows)
+        C[r0:r0 + nu - 1, :m] = cum
         z0 = np.r_[z_state, piece.xi0, 1.0]
         t1 = min(piece.t1, math.inf)
         ka = int(math.ceil((piece.t0 - t_start) / dt - 1e-9))

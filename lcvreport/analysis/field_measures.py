@@ -31,7 +31,7 @@ from ..model.vehicle import Vehicle
 from .exact import ManoeuvreError, ManoeuvreResponse, response
 from .geometry import point_lateral_map
 from .manoeuvres import G_MPS2, lane_change, lane_change_offset_m, pulse
-from .measures import steady_with_yaw_rate, steer_to_acceleration
+from .measures import steady_with_yaw_rate
 
 #: the RA(f) search band [Hz]
 RA_BAND_HZ = (0.1, 2.0)
@@ -74,9 +74,20 @@ def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RAPe
     from scipy.optimize import minimize_scalar
     lo, hi = RA_BAND_HZ
     f = np.linspace(lo, hi, 381)
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    co = system_coefficients(vehicle)           # once: Brent's method asks for ~25 single frequencies
+    u = float(speed_mps)
+    M, S, b = co.M(u), co.S(u, tire_scale), co.B_delta(tire_scale)
+    ends = np.array([0, vehicle.n_units - 1])
+    V, R = co.velocity_map(u)[ends], co.yaw_rate_map()[ends]
 
     def ra(x):
-        G = np.abs(steer_to_acceleration(vehicle, speed_mps, np.atleast_1d(x), tire_scale))
+        """RA at the frequencies x [Hz]: as steer_to_acceleration (first and last unit only)."""
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        w = 2 * np.pi * x[..., None, None]
+        z = np.linalg.solve(1j * w * M - S, np.broadcast_to(b, x.shape + b.shape)[..., None])[..., 0]
+        G = np.abs(z @ V.T * (1j * 2 * np.pi * x[..., None]) + u * (z @ R.T))
         return G[..., -1] / G[..., 0]
 
     values = ra(f)
