@@ -212,6 +212,9 @@ def _hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
     sign, slopes d0, d1 per unit time over a step h), vectorized: Newton from the secant
     root, kept inside a bracket that shrinks with every iterate (safeguarded)."""
     f0, d0, f1, d1 = (np.asarray(a, dtype=float) for a in (f0, d0, f1, d1))
+    if f0.ndim == 1 and f0.size <= 64:     # the usual few roots: the same iteration on floats, no array overhead
+        return np.array([_hermite_root(*args, float(h)) for args in zip(f0.tolist(), d0.tolist(), f1.tolist(),
+                                                                 d1.tolist())])
     d0, d1 = d0 * h, d1 * h
     a = 2 * f0 - 2 * f1 + d0 + d1
     b = -3 * f0 + 3 * f1 - 2 * d0 - d1
@@ -237,6 +240,37 @@ def _hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
         if np.all(np.abs(new - tau) <= 1e-13):
             tau = new
             break
+        tau = new
+    return tau
+
+
+def _hermite_root(f0: float, d0: float, f1: float, d1: float, h: float) -> float:
+    """:func:`_hermite_roots` of one interval, on Python floats: the same safeguarded Newton
+    iteration, stopped when this interval's own iterate settles (the array version stops when
+    all have; the roots agree to rounding)."""
+    d0, d1 = d0 * h, d1 * h
+    a = 2 * f0 - 2 * f1 + d0 + d1
+    b = -3 * f0 + 3 * f1 - 2 * d0 - d1
+    if f0 == 0:
+        return 0.0
+    if f1 == 0:
+        return 1.0
+    denom = f0 - f1
+    tau = min(max(f0 / denom, 0.0), 1.0) if denom != 0 else 0.0
+    lo, hi = 0.0, 1.0
+    s0 = (f0 > 0) - (f0 < 0)
+    for _ in range(40):
+        p = ((a * tau + b) * tau + d0) * tau + f0
+        dp = (3 * a * tau + 2 * b) * tau + d0
+        if ((p > 0) - (p < 0)) == s0:
+            lo = tau
+        else:
+            hi = tau
+        new = tau - (p / dp if dp != 0 else 0.0)
+        if new < lo or new > hi or not math.isfinite(new):
+            new = 0.5 * (lo + hi)
+        if abs(new - tau) <= 1e-13:
+            return new
         tau = new
     return tau
 
