@@ -146,7 +146,7 @@ class ManoeuvreResponse:
             t = self.time[seg.k0:seg.k0 + len(seg.Z)]
             if t.size == 0:
                 continue
-            y, d1, d2 = seg.Z @ c, seg.Z @ c1, seg.Z @ c2
+            y, d1, d2 = (seg.Z @ np.column_stack([c, c1, c2])).T      # one product for the three
             dt = t[1] - t[0] if t.size > 1 else 0.0
             # a sign change of the derivative, or a zero of it at a sample (not a flat stretch)
             change = np.flatnonzero(((d1[:-1] > 0) != (d1[1:] > 0)) & ((d1[:-1] != 0) | (d1[1:] != 0)))
@@ -182,6 +182,8 @@ class ManoeuvreResponse:
                 ts = self.time[seg.k0:seg.k0 + len(seg.Z)]
                 k = int(np.searchsorted(ts, t, side="right")) - 1
                 t_base, z = (seg.t0, seg.z_start) if k < 0 else (ts[k], seg.Z[k])
+                if t == t_base:                         # a sample (or the piece's start): no exponential
+                    return float(seg.C[j] @ z)
                 return float(seg.C[j] @ expm(seg.Mz * (t - t_base)) @ z)
         raise ValueError(f"t = {t} s is outside the response")  # pragma: no cover
 
