@@ -167,3 +167,20 @@ def test_ra_peak_does_not_depend_on_the_batch_or_the_scan(monkeypatch):
     monkeypatch.setattr(batch_module, "SCAN_COND_MAX", 0.0)             # every variant: the exact scan
     exact = VariantBatch(v, values).ra_peak(22.0)
     assert np.array_equal(exact[0], whole[0]) and np.array_equal(exact[1], whole[1])
+
+
+@pytest.mark.parametrize("preset,speed", [("aucnat", 24.0), ("tractor_semitrailer", 30.0), ("legal_max", 14.0)])
+def test_batched_single_sine_is_the_one_variant_single_sine(preset, speed):
+    """RA of the single sine on the continuous exact response, every variant at once (in groups
+    of 64), against measures.single_sine of each variant built on its own: 1e-12 relative (what
+    differs is the scaling the matrix exponential chooses for the smaller augmented matrices)."""
+    from lcvreport.analysis.measures import single_sine
+    v = load_preset(preset)
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(9)
+    B = 70                                     # two groups
+    values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, B) for n in names}
+    ra = VariantBatch(v, values).single_sine(speed)
+    for i in (0, 1, 63, 64, 69):
+        ref = single_sine(_variant(v, values, i), speed).rearward_amplification
+        assert ra[i] == pytest.approx(ref, rel=1e-12), i

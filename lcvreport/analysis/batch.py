@@ -268,6 +268,130 @@ class VariantBatch:
             where[idx] = np.where(better, xm, where[idx])
         return best, where
 
+    def ay_peaks(self, speed_mps: float, steer, t_end: float, dt: float, units=None,
+                 tire_scale: float = 1.0) -> np.ndarray:
+        """max |a_i(t)| [m/s^2] of the units ``units`` of every variant under ``steer``: see
+        :meth:`_ay_peaks` (computed 64 variants at a time: the sampled states stay in cache,
+        0.57 ms per variant for the single sine of aucnat against 2.6 ms one by one)."""
+        B = self.size
+        return np.concatenate([self._ay_peaks(speed_mps, steer, t_end, dt, units, tire_scale,
+                                              np.arange(i, min(B, i + 64))) for i in range(0, B, 64)])
+
+    def _ay_peaks(self, speed_mps: float, steer, t_end: float, dt: float, units, tire_scale: float,
+                  rows: np.ndarray) -> np.ndarray:
+        """max |a_i(t)| [m/s^2] over the continuous exact response from rest to ``steer`` (a
+        steer input of :mod:`lcvreport.analysis.manoeuvres`, not a lane change) on
+        ``[0, t_end]``, of the units ``units`` (0-based; default every unit) of every variant,
+        shape (B, len(units)): the algorithm of :func:`lcvreport.analysis.exact.response` and
+        :meth:`~lcvreport.analysis.exact.ManoeuvreResponse.peak_abs` run on all variants at once
+        (samples every ``dt`` by powers of each piece's exponential, the extrema between samples
+        from the derivatives' Hermite interpolants, the pieces' ends, the window's ends)."""
+        from scipy.linalg import expm
+        from .exact import _hermite_roots, _quintic
+        v = self.vehicle
+        co = system_coefficients(v)
+        c = {k: a[rows] for k, a in self.coefficients.items()}
+        u = float(speed_mps)
+        n, nu, B = v.n_states, v.n_units, rows.size
+        m = n + 2
+        units = list(range(nu)) if units is None else list(units)
+        M = c["M0"] + u * c["M1"]
+        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        AG = solve_scaled(M, np.concatenate([S, np.broadcast_to(np.eye(n), (B, n, n))], axis=-1))
+        A_x, Minv = AG[..., :n], AG[..., n:]
+        Aa = np.zeros((B, m, m))
+        Aa[:, :n, :n] = A_x
+        Aa[:, n, 1] = 1.0
+        Aa[:, n + 1, 0] = 1.0
+        Aa[:, n + 1, n] = u
+        bd_x = np.zeros((B, m))
+        bd_x[:, :n] = np.einsum("bij,bj->bi", Minv, tire_scale * c["Bdelta"])
+        Vmap, Rmap = co.velocity_map(u)[units], co.yaw_rate_map()[units]
+        Ca = np.einsum("kn,bnj->bkj", Vmap, A_x) + u * Rmap                    # (B, K, n)
+        da = np.einsum("kn,bn->bk", Vmap, bd_x[:, :n])                          # (B, K)
+        n_steps = int(round(t_end / dt))
+        peak = np.zeros((B, len(units)))
+        z_state = np.zeros((B, m))
+        for piece in steer.pieces:
+            if piece.t0 > t_end + 1e-12:
+                break
+            p = piece.E.shape[0]
+            dim = m + p + 1
+            Mz = np.zeros((B, dim, dim))
+            Mz[:, :m, :m] = Aa
+            Mz[:, :m, m:m + p] = bd_x[:, :, None] * piece.h[None, None, :]
+            Mz[:, m:m + p, m:m + p] = piece.E
+            d_row = np.zeros(dim)
+            d_row[m:m + p] = piece.h
+            C = np.zeros((B, len(units), dim))                                 # ay rows over z
+            C[:, :, :n] = Ca
+            C += da[:, :, None] * d_row
+            z0 = np.concatenate([z_state, np.broadcast_to(piece.xi0, (B, p)), np.ones((B, 1))], axis=1)
+            t1 = piece.t1
+            ka = int(math.ceil(piece.t0 / dt - 1e-9))
+            kb = n_steps if t1 > t_end + 1e-12 else int(math.ceil(t1 / dt - 1e-9)) - 1
+            count = kb - ka + 1
+            z_end = None
+            if count > 0:
+                ta = ka * dt
+                za = z0 if abs(ta - piece.t0) <= 1e-12 * max(1.0, piece.t0) else \
+                    np.einsum("bij,bj->bi", expm(Mz * (ta - piece.t0)), z0)
+                Phi = expm(Mz * dt)
+                Z = np.empty((B, count, dim))                                  # powers by doubling
+                Z[:, 0] = za
+                filled, P = 1, Phi
+                with np.errstate(over="ignore", invalid="ignore"):
+                    while filled < count:
+                        take = min(filled, count - filled)
+                        Z[:, filled:filled + take] = Z[:, :take] @ np.swapaxes(P, 1, 2)
+                        filled += take
+                        if filled < count:
+                            P = P @ P
+                if math.isfinite(t1) and t1 <= t_end + 1e-12:
+                    z_end = np.einsum("bij,bj->bi", expm(Mz * (t1 - kb * dt)), Z[:, -1])
+                # extrema between samples of this piece
+                C1 = C @ Mz
+                C2 = C1 @ Mz
+                Y = Z @ np.swapaxes(C, 1, 2)                                    # (B, count, K)
+                D1 = Z @ np.swapaxes(C1, 1, 2)
+                D2 = Z @ np.swapaxes(C2, 1, 2)
+                change = ((D1[:, :-1] > 0) != (D1[:, 1:] > 0)) & ((D1[:, :-1] != 0) | (D1[:, 1:] != 0))
+                b_i, k_i, s_i = np.nonzero(change)
+                if b_i.size:
+                    k1 = k_i + 1
+                    tau = _hermite_roots(D1[b_i, k_i, s_i], D2[b_i, k_i, s_i], D1[b_i, k1, s_i], D2[b_i, k1, s_i],
+                                         dt)
+                    val = _quintic(Y[b_i, k_i, s_i], D1[b_i, k_i, s_i], D2[b_i, k_i, s_i], Y[b_i, k1, s_i],
+                                   D1[b_i, k1, s_i], D2[b_i, k1, s_i], dt, tau)
+                    np.maximum.at(peak, (b_i, s_i), np.abs(val))
+                # the piece's ends (its start value and its end value)
+                peak = np.maximum(peak, np.abs(np.einsum("bkd,bd->bk", C, z0)))
+                if z_end is not None:
+                    peak = np.maximum(peak, np.abs(np.einsum("bkd,bd->bk", C, z_end)))
+                if kb == n_steps:                                               # the window's end: the last sample
+                    peak = np.maximum(peak, np.abs(Y[:, -1]))
+            else:
+                if math.isfinite(t1):
+                    z_end = np.einsum("bij,bj->bi", expm(Mz * (t1 - piece.t0)), z0)
+            if z_end is None:
+                break
+            z_state = z_end[:, :m]
+        return peak
+
+    def single_sine(self, speed_mps: float, f_hz: float | None = None, tire_scale: float = 1.0) -> np.ndarray:
+        """RA of the single sine [-] of every variant: max|a_N| / max|a_1| on the continuous exact
+        response (:func:`lcvreport.analysis.measures.single_sine`: ``delta0 sin(2 pi f t)`` for one
+        period, then the tail)."""
+        from .manoeuvres import sine
+        from .measures import (RA_FREQUENCY_HZ, SINGLE_SINE_DELTA0_RAD, SINGLE_SINE_STEP_S, SINGLE_SINE_TAIL_S,
+                               _freq)
+        f = float(_freq(RA_FREQUENCY_HZ if f_hz is None else f_hz))
+        steer = sine(SINGLE_SINE_DELTA0_RAD, f)
+        t_end = round((1.0 / f + SINGLE_SINE_TAIL_S) / SINGLE_SINE_STEP_S) * SINGLE_SINE_STEP_S
+        peaks = self.ay_peaks(speed_mps, steer, t_end, SINGLE_SINE_STEP_S, [0, self.vehicle.n_units - 1],
+                              tire_scale)
+        return peaks[:, 1] / peaks[:, 0]
+
     def _steady(self, u: float, F, r1: float, tire_scale: float) -> tuple[np.ndarray, np.ndarray]:
         """S x + b delta + F = 0 with x[1] = r1 for every variant, as
         :func:`lcvreport.analysis.measures.steady_with_yaw_rate`: (x (B, 2N), delta (B,))."""
@@ -390,6 +514,7 @@ class VariantBatch:
         table.update({"speed_mps": np.full(self.size, float(speed_mps)), "least_damping_ratio": zeta,
                       "least_damped_frequency_hz": f_zeta, "critical_speed_kph": crit,
                       "ra_frequency": self.rearward_amplification(speed_mps, f_hz, tire_scale),
+                      "ra_single_sine": self.single_sine(speed_mps, f_hz, tire_scale),
                       "ra_peak": peak, "ra_peak_frequency_hz": peak_f, "hsso_m": hsso,
                       "steady_turn_delta_rad": turn_delta})
         if F is not None:
