@@ -254,7 +254,8 @@ def test_the_study_report(tmp_path):
     table = read_study(tmp_path / "out")
     passed = int(((table["hsso_m"] <= 0.05) & (table["ra_peak"] <= 9.0)).sum())
     import csv
-    rows = list(csv.DictReader(open(tmp_path / "rep" / "data" / "table_S-3.csv")))
+    with open(tmp_path / "rep" / "data" / "table_S-3.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
     assert int(rows[-1]["passed"]) == passed and int(rows[-1]["judged"]) == 60
     (tmp_path / "rep2").mkdir()
     (tmp_path / "rep2" / "mine.txt").write_text("keep")
