@@ -184,3 +184,24 @@ def test_batched_single_sine_is_the_one_variant_single_sine(preset, speed):
     for i in (0, 1, 63, 64, 69):
         ref = single_sine(_variant(v, values, i), speed).rearward_amplification
         assert ra[i] == pytest.approx(ref, rel=1e-12), i
+
+
+@pytest.mark.parametrize("preset,speed", [("aucnat", 24.0), ("tractor_semitrailer", 30.0), ("legal_max", 20.0)])
+def test_batched_yaw_damping_is_the_one_variant_coefficient(preset, speed):
+    """The pulse, each joint's extrema after it on the continuous response, the ratio method:
+    every variant at once against field_measures.yaw_damping_coefficient of each.  1e-11
+    relative: d = ln(P_i / P_(i+1)) of peak-to-peak amplitudes takes the extrema's rounding
+    (1e-14 of the peaks, located by different exponentials' scalings) to about 1e-12."""
+    from lcvreport.analysis.field_measures import yaw_damping_coefficient
+    v = load_preset(preset)
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(10)
+    B = 66
+    values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, B) for n in names}
+    ydc = VariantBatch(v, values).yaw_damping(speed)
+    for i in (0, 7, 63, 64, 65):
+        ref = yaw_damping_coefficient(_variant(v, values, i), speed).value
+        if ref is None:
+            assert np.isnan(ydc[i])
+        else:
+            assert ydc[i] == pytest.approx(ref, rel=1e-11), i

@@ -23,7 +23,7 @@ from lcvreport.study.spec import BATCHED, MEASURES, StudyError, load_study, stud
 ROOT = Path(__file__).resolve().parents[1]
 LCV = [sys.executable, "-m", "lcvreport.cli"]
 
-SMALL = {"vehicle": "aucnat", "measures": list(BATCHED) + ["yaw_damping_coefficient"],
+SMALL = {"vehicle": "aucnat", "measures": list(BATCHED) + ["hsto_m"],
          "design": {"kind": "random", "count": 12, "seed": 7}, "chunk_size": 5,
          "factors": {"speed_kph": {"values": [70.0, 95.0]},
                      "trailer3.mass_scale": {"distribution": "uniform", "low": 0.6, "high": 1.1},
@@ -81,7 +81,8 @@ def test_every_row_is_measure_set_of_its_case(tmp_path):
         for m in SMALL["measures"]:
             # where a smooth maximum lies is known to about sqrt(eps) of its frequency, by the batch's
             # golden section and measure_set's Brent method alike (tests/test_batch.py); values to 1e-12
-            rel = 1e-6 if m == "ra_peak_frequency_hz" else 1e-12
+            # YDC: a log-ratio of peak-to-peak amplitudes, to 1e-11 (tests/test_batch.py)
+            rel = 1e-6 if m == "ra_peak_frequency_hz" else 1e-11 if m == "yaw_damping_coefficient" else 1e-12
             assert _close(row[m], doc[m], rel), (int(row["case_id"]), m, row[m], doc[m])
 
 

@@ -277,24 +277,18 @@ class VariantBatch:
         return np.concatenate([self._ay_peaks(speed_mps, steer, t_end, dt, units, tire_scale,
                                               np.arange(i, min(B, i + 64))) for i in range(0, B, 64)])
 
-    def _ay_peaks(self, speed_mps: float, steer, t_end: float, dt: float, units, tire_scale: float,
-                  rows: np.ndarray) -> np.ndarray:
-        """max |a_i(t)| [m/s^2] over the continuous exact response from rest to ``steer`` (a
-        steer input of :mod:`lcvreport.analysis.manoeuvres`, not a lane change) on
-        ``[0, t_end]``, of the units ``units`` (0-based; default every unit) of every variant,
-        shape (B, len(units)): the algorithm of :func:`lcvreport.analysis.exact.response` and
-        :meth:`~lcvreport.analysis.exact.ManoeuvreResponse.peak_abs` run on all variants at once
-        (samples every ``dt`` by powers of each piece's exponential, the extrema between samples
-        from the derivatives' Hermite interpolants, the pieces' ends, the window's ends)."""
+    def _pieces(self, speed_mps: float, steer, t_end: float, dt: float, tire_scale: float, rows: np.ndarray):
+        """The exact response of the variants ``rows`` from rest to ``steer`` (not a lane change),
+        piece by piece as :func:`lcvreport.analysis.exact.response` computes it: yields per piece
+        ``(Mz, z0, Z, z_end, ka, kb, d_row, ctx)`` with the augmented matrices (B, dim, dim) over
+        ``z = [x, psi1, Y1, xi, 1]``, the state at the piece's start, the samples ``ka..kb`` (B,
+        count, dim; None if the piece holds no sample), the state at its end (None: it lasts past
+        t_end), the steer's row over z, and ``ctx`` (A_x, bd_x, m, n)."""
         from scipy.linalg import expm
-        from .exact import _hermite_roots, _quintic
-        v = self.vehicle
-        co = system_coefficients(v)
         c = {k: a[rows] for k, a in self.coefficients.items()}
         u = float(speed_mps)
-        n, nu, B = v.n_states, v.n_units, rows.size
+        n, B = self.vehicle.n_states, rows.size
         m = n + 2
-        units = list(range(nu)) if units is None else list(units)
         M = c["M0"] + u * c["M1"]
         S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
         AG = solve_scaled(M, np.concatenate([S, np.broadcast_to(np.eye(n), (B, n, n))], axis=-1))
@@ -306,11 +300,8 @@ class VariantBatch:
         Aa[:, n + 1, n] = u
         bd_x = np.zeros((B, m))
         bd_x[:, :n] = np.einsum("bij,bj->bi", Minv, tire_scale * c["Bdelta"])
-        Vmap, Rmap = co.velocity_map(u)[units], co.yaw_rate_map()[units]
-        Ca = np.einsum("kn,bnj->bkj", Vmap, A_x) + u * Rmap                    # (B, K, n)
-        da = np.einsum("kn,bn->bk", Vmap, bd_x[:, :n])                          # (B, K)
+        ctx = (A_x, bd_x, m, n)
         n_steps = int(round(t_end / dt))
-        peak = np.zeros((B, len(units)))
         z_state = np.zeros((B, m))
         for piece in steer.pieces:
             if piece.t0 > t_end + 1e-12:
@@ -323,23 +314,20 @@ class VariantBatch:
             Mz[:, m:m + p, m:m + p] = piece.E
             d_row = np.zeros(dim)
             d_row[m:m + p] = piece.h
-            C = np.zeros((B, len(units), dim))                                 # ay rows over z
-            C[:, :, :n] = Ca
-            C += da[:, :, None] * d_row
             z0 = np.concatenate([z_state, np.broadcast_to(piece.xi0, (B, p)), np.ones((B, 1))], axis=1)
             t1 = piece.t1
             ka = int(math.ceil(piece.t0 / dt - 1e-9))
             kb = n_steps if t1 > t_end + 1e-12 else int(math.ceil(t1 / dt - 1e-9)) - 1
             count = kb - ka + 1
-            z_end = None
+            z_end, Z = None, None
             if count > 0:
                 ta = ka * dt
                 za = z0 if abs(ta - piece.t0) <= 1e-12 * max(1.0, piece.t0) else \
                     np.einsum("bij,bj->bi", expm(Mz * (ta - piece.t0)), z0)
-                Phi = expm(Mz * dt)
+                P = expm(Mz * dt)
                 Z = np.empty((B, count, dim))                                  # powers by doubling
                 Z[:, 0] = za
-                filled, P = 1, Phi
+                filled = 1
                 with np.errstate(over="ignore", invalid="ignore"):
                     while filled < count:
                         take = min(filled, count - filled)
@@ -349,34 +337,101 @@ class VariantBatch:
                             P = P @ P
                 if math.isfinite(t1) and t1 <= t_end + 1e-12:
                     z_end = np.einsum("bij,bj->bi", expm(Mz * (t1 - kb * dt)), Z[:, -1])
-                # extrema between samples of this piece
-                C1 = C @ Mz
-                C2 = C1 @ Mz
-                Y = Z @ np.swapaxes(C, 1, 2)                                    # (B, count, K)
-                D1 = Z @ np.swapaxes(C1, 1, 2)
-                D2 = Z @ np.swapaxes(C2, 1, 2)
-                change = ((D1[:, :-1] > 0) != (D1[:, 1:] > 0)) & ((D1[:, :-1] != 0) | (D1[:, 1:] != 0))
-                b_i, k_i, s_i = np.nonzero(change)
-                if b_i.size:
-                    k1 = k_i + 1
-                    tau = _hermite_roots(D1[b_i, k_i, s_i], D2[b_i, k_i, s_i], D1[b_i, k1, s_i], D2[b_i, k1, s_i],
-                                         dt)
-                    val = _quintic(Y[b_i, k_i, s_i], D1[b_i, k_i, s_i], D2[b_i, k_i, s_i], Y[b_i, k1, s_i],
-                                   D1[b_i, k1, s_i], D2[b_i, k1, s_i], dt, tau)
-                    np.maximum.at(peak, (b_i, s_i), np.abs(val))
-                # the piece's ends (its start value and its end value)
-                peak = np.maximum(peak, np.abs(np.einsum("bkd,bd->bk", C, z0)))
-                if z_end is not None:
-                    peak = np.maximum(peak, np.abs(np.einsum("bkd,bd->bk", C, z_end)))
-                if kb == n_steps:                                               # the window's end: the last sample
-                    peak = np.maximum(peak, np.abs(Y[:, -1]))
-            else:
-                if math.isfinite(t1):
-                    z_end = np.einsum("bij,bj->bi", expm(Mz * (t1 - piece.t0)), z0)
+            elif math.isfinite(t1):
+                z_end = np.einsum("bij,bj->bi", expm(Mz * (t1 - piece.t0)), z0)
+            yield Mz, z0, Z, z_end, ka, kb, d_row, ctx
             if z_end is None:
                 break
             z_state = z_end[:, :m]
+
+    @staticmethod
+    def _between_samples(Z, C, Mz, dt: float, t0: float):
+        """The extrema strictly between samples of the signals ``C`` (B, K, dim) over the samples
+        ``Z`` (B, count, dim) of one piece starting at sample time ``t0``: zeros of each signal's
+        derivative located on its Hermite interpolant, valued by the quintic one (as
+        :meth:`~lcvreport.analysis.exact.ManoeuvreResponse.extrema`).  Flat arrays (variant,
+        signal, time [s], value) and the signals' values at the samples (B, count, K)."""
+        from .exact import _hermite_roots, _quintic
+        C1 = C @ Mz
+        C2 = C1 @ Mz
+        Y = Z @ np.swapaxes(C, 1, 2)
+        D1 = Z @ np.swapaxes(C1, 1, 2)
+        D2 = Z @ np.swapaxes(C2, 1, 2)
+        change = ((D1[:, :-1] > 0) != (D1[:, 1:] > 0)) & ((D1[:, :-1] != 0) | (D1[:, 1:] != 0))
+        b_i, k_i, s_i = np.nonzero(change)
+        if not b_i.size:
+            return b_i, s_i, np.zeros(0), np.zeros(0), Y
+        k1 = k_i + 1
+        tau = _hermite_roots(D1[b_i, k_i, s_i], D2[b_i, k_i, s_i], D1[b_i, k1, s_i], D2[b_i, k1, s_i], dt)
+        val = _quintic(Y[b_i, k_i, s_i], D1[b_i, k_i, s_i], D2[b_i, k_i, s_i], Y[b_i, k1, s_i], D1[b_i, k1, s_i],
+                       D2[b_i, k1, s_i], dt, tau)
+        return b_i, s_i, t0 + (k_i + tau) * dt, val, Y
+
+    def _ay_peaks(self, speed_mps: float, steer, t_end: float, dt: float, units, tire_scale: float,
+                  rows: np.ndarray) -> np.ndarray:
+        v = self.vehicle
+        co = system_coefficients(v)
+        u = float(speed_mps)
+        units = list(range(v.n_units)) if units is None else list(units)
+        n_steps = int(round(t_end / dt))
+        peak = np.zeros((rows.size, len(units)))
+        Vmap, Rmap = co.velocity_map(u)[units], co.yaw_rate_map()[units]
+        for Mz, z0, Z, z_end, ka, kb, d_row, (A_x, bd_x, m, n) in self._pieces(speed_mps, steer, t_end, dt,
+                                                                             tire_scale, rows):
+            C = np.zeros((rows.size, len(units), Mz.shape[-1]))                # ay rows over z
+            C[:, :, :n] = np.einsum("kn,bnj->bkj", Vmap, A_x) + u * Rmap
+            C += np.einsum("kn,bn->bk", Vmap, bd_x[:, :n])[:, :, None] * d_row
+            if Z is None:
+                continue
+            b_i, s_i, _t, val, Y = self._between_samples(Z, C, Mz, dt, ka * dt)
+            np.maximum.at(peak, (b_i, s_i), np.abs(val))
+            peak = np.maximum(peak, np.abs(np.einsum("bkd,bd->bk", C, z0)))      # the piece's ends
+            if z_end is not None:
+                peak = np.maximum(peak, np.abs(np.einsum("bkd,bd->bk", C, z_end)))
+            if kb == n_steps:                                                      # the window's end
+                peak = np.maximum(peak, np.abs(Y[:, -1]))
         return peak
+
+    def yaw_damping(self, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+        """The yaw damping coefficient [-] of every variant
+        (:func:`lcvreport.analysis.field_measures.yaw_damping_coefficient`: the pulse, each joint's
+        extrema from its end to 40 s after on the continuous response, the ratio method, the
+        smallest over the joints); NaN where no joint has two amplitudes."""
+        from .field_measures import YDC_DT_S, YDC_PULSE, YDC_WINDOW_S, ratio_damping
+        from .manoeuvres import pulse
+        v = self.vehicle
+        B = self.size
+        out = np.full(B, np.nan)
+        if v.n_units < 2:
+            return out
+        A, D = YDC_PULSE
+        steer = pulse(A, D)
+        t_end = round((D + YDC_WINDOW_S) / YDC_DT_S) * YDC_DT_S
+        lo, hi = D + 1e-12, D + YDC_WINDOW_S - 1e-12
+        joints = v.n_units - 1
+        for g in range(0, B, 64):
+            rows = np.arange(g, min(B, g + 64))
+            found = []
+            for Mz, _z0, Z, _z_end, ka, _kb, _d, (_A, _b, m, n) in self._pieces(speed_mps, steer, t_end, YDC_DT_S,
+                                                                               tire_scale, rows):
+                if Z is None:
+                    continue
+                C = np.zeros((rows.size, joints, Mz.shape[-1]))                 # theta rows over z
+                C[:, np.arange(joints), v.n_units + 1 + np.arange(joints)] = 1.0
+                b_i, s_i, t, val, _Y = self._between_samples(Z, C, Mz, YDC_DT_S, ka * YDC_DT_S)
+                keep = (t > lo) & (t < hi)
+                found.append((b_i[keep], s_i[keep], t[keep], val[keep]))
+            b_i, s_i, t, val = (np.concatenate(a) for a in zip(*found))
+            order = np.lexsort((t, s_i, b_i))
+            b_i, s_i, val = b_i[order], s_i[order], val[order]
+            starts = np.flatnonzero(np.r_[True, (b_i[1:] != b_i[:-1]) | (s_i[1:] != s_i[:-1])])
+            ends = np.r_[starts[1:], b_i.size]
+            for a, e in zip(starts, ends):
+                zeta, _P = ratio_damping(val[a:e])
+                if zeta is not None:
+                    k = rows[b_i[a]]
+                    out[k] = zeta if np.isnan(out[k]) else min(out[k], zeta)
+        return out
 
     def single_sine(self, speed_mps: float, f_hz: float | None = None, tire_scale: float = 1.0) -> np.ndarray:
         """RA of the single sine [-] of every variant: max|a_N| / max|a_1| on the continuous exact
@@ -515,6 +570,7 @@ class VariantBatch:
                       "least_damped_frequency_hz": f_zeta, "critical_speed_kph": crit,
                       "ra_frequency": self.rearward_amplification(speed_mps, f_hz, tire_scale),
                       "ra_single_sine": self.single_sine(speed_mps, f_hz, tire_scale),
+                      "yaw_damping_coefficient": self.yaw_damping(speed_mps, tire_scale),
                       "ra_peak": peak, "ra_peak_frequency_hz": peak_f, "hsso_m": hsso,
                       "steady_turn_delta_rad": turn_delta})
         if F is not None:

@@ -32,6 +32,8 @@ def _batched(batch: VariantBatch, speed_mps: float, tire_scale: float, wanted: s
         out["critical_speed_kph"] = batch.critical_speed(tire_scale)
     if "ra_frequency" in wanted:
         out["ra_frequency"] = batch.rearward_amplification(speed_mps, RA_FREQUENCY_HZ, tire_scale)
+    if "yaw_damping_coefficient" in wanted:
+        out["yaw_damping_coefficient"] = batch.yaw_damping(speed_mps, tire_scale)
     if "ra_single_sine" in wanted:
         out["ra_single_sine"] = batch.single_sine(speed_mps, RA_FREQUENCY_HZ, tire_scale)
     if wanted & {"ra_peak", "ra_peak_frequency_hz"}:
