@@ -205,3 +205,20 @@ def test_batched_yaw_damping_is_the_one_variant_coefficient(preset, speed):
             assert np.isnan(ydc[i])
         else:
             assert ydc[i] == pytest.approx(ref, rel=1e-11), i
+
+
+@pytest.mark.parametrize("preset,speed", [("aucnat", 24.0), ("tractor_semitrailer", 30.0), ("empty", 22.0)])
+def test_batched_lane_change_is_the_one_variant_lane_change(preset, speed):
+    """HSTO and the lane change's RA through every variant's inverse system at once, against
+    field_measures.lane_change_measures of each: 1e-12 relative (HSTO absolute 1e-12 m where 0)."""
+    from lcvreport.analysis.field_measures import lane_change_measures
+    v = load_preset(preset)
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(11)
+    B = 66
+    values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, B) for n in names}
+    hsto, ra = VariantBatch(v, values).lane_change(speed)
+    for i in (0, 5, 63, 64, 65):
+        ref = lane_change_measures(_variant(v, values, i), speed)
+        assert hsto[i] == pytest.approx(ref.hsto_m, rel=1e-12, abs=1e-12), i
+        assert ra[i] == pytest.approx(ref.ra_lane_change, rel=1e-12), i

@@ -23,7 +23,7 @@ from lcvreport.study.spec import BATCHED, MEASURES, StudyError, load_study, stud
 ROOT = Path(__file__).resolve().parents[1]
 LCV = [sys.executable, "-m", "lcvreport.cli"]
 
-SMALL = {"vehicle": "aucnat", "measures": list(BATCHED) + ["hsto_m"],
+SMALL = {"vehicle": "aucnat", "measures": list(BATCHED) + ["max_tail_swing_m"],
          "design": {"kind": "random", "count": 12, "seed": 7}, "chunk_size": 5,
          "factors": {"speed_kph": {"values": [70.0, 95.0]},
                      "trailer3.mass_scale": {"distribution": "uniform", "low": 0.6, "high": 1.1},

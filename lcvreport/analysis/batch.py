@@ -1,6 +1,8 @@
 """Variants of one vehicle in a batch: masses, yaw inertias and tire coefficients as arrays,
-the model's matrices and the damping measures batched over the leading axis (SPEC section 14,
-issue 21; first part).
+the model's matrices and the measures of ``measure_set`` batched over the leading axis (SPEC
+section 14, issue 21): damping, critical speed, RA(f), the RA peak, the single sine, the yaw
+damping coefficient of the pulse, HSTO and RA of the lane change, HSSO, the trim.  The time
+responses are the exact ones of :mod:`lcvreport.analysis.exact` run on 64 variants at a time.
 
 Every coefficient of the model (M0, M1, S0, Sinv, Su, Skin, B_delta) is affine in each unit's
 mass and yaw inertia and in each axle's per-tire C_F, C_M and C_S (positions held): the batch
@@ -301,6 +303,16 @@ class VariantBatch:
         bd_x = np.zeros((B, m))
         bd_x[:, :n] = np.einsum("bij,bj->bi", Minv, tire_scale * c["Bdelta"])
         ctx = (A_x, bd_x, m, n)
+        lane = steer.prescribes_acceleration
+        if lane:                     # the inverse system: x' = (A - b Cs/Ds) x + b a_s / Ds (no residual force)
+            from .exact import steered_point
+            b_x = bd_x[:, :n]
+            Js = np.zeros(n)
+            Js[0], Js[1] = 1.0, steered_point(self.vehicle)
+            Cs = np.einsum("k,bkj->bj", Js, A_x)
+            Cs[:, 1] += u
+            Ds = b_x @ Js
+            ctx = (A_x, bd_x, m, n, Cs, Ds)
         n_steps = int(round(t_end / dt))
         z_state = np.zeros((B, m))
         for piece in steer.pieces:
@@ -310,10 +322,17 @@ class VariantBatch:
             dim = m + p + 1
             Mz = np.zeros((B, dim, dim))
             Mz[:, :m, :m] = Aa
-            Mz[:, :m, m:m + p] = bd_x[:, :, None] * piece.h[None, None, :]
+            if lane:
+                Mz[:, :n, :n] = A_x - b_x[:, :, None] * Cs[:, None, :] / Ds[:, None, None]
+                Mz[:, :n, m:m + p] = b_x[:, :, None] * piece.h[None, None, :] / Ds[:, None, None]
+                d_row = np.zeros((B, dim))             # the steer: (a_s - Cs x) / Ds
+                d_row[:, :n] = -Cs / Ds[:, None]
+                d_row[:, m:m + p] = piece.h[None, :] / Ds[:, None]
+            else:
+                Mz[:, :m, m:m + p] = bd_x[:, :, None] * piece.h[None, None, :]
+                d_row = np.zeros(dim)
+                d_row[m:m + p] = piece.h
             Mz[:, m:m + p, m:m + p] = piece.E
-            d_row = np.zeros(dim)
-            d_row[m:m + p] = piece.h
             z0 = np.concatenate([z_state, np.broadcast_to(piece.xi0, (B, p)), np.ones((B, 1))], axis=1)
             t1 = piece.t1
             ka = int(math.ceil(piece.t0 / dt - 1e-9))
@@ -367,30 +386,124 @@ class VariantBatch:
                        D2[b_i, k1, s_i], dt, tau)
         return b_i, s_i, t0 + (k_i + tau) * dt, val, Y
 
+    def _extremes(self, speed_mps: float, steer, t_end: float, dt: float, signals, tire_scale: float,
+                  rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(largest, smallest) value of the signals over the continuous response on [0, t_end]
+        among its extrema, the pieces' ends and the window's ends (as ``extrema``), shape (B, K);
+        ``signals(Mz, d_row, ctx)`` gives the signals' rows over z (B, K, dim) for a piece."""
+        n_steps = int(round(t_end / dt))
+        hi = lo = None
+        for Mz, z0, Z, z_end, ka, kb, d_row, ctx in self._pieces(speed_mps, steer, t_end, dt, tire_scale, rows):
+            C = signals(Mz, d_row, ctx)
+            if hi is None:
+                hi = np.full(C.shape[:2], -np.inf)
+                lo = np.full(C.shape[:2], np.inf)
+            if Z is not None:
+                b_i, s_i, _t, val, Y = self._between_samples(Z, C, Mz, dt, ka * dt)
+                np.maximum.at(hi, (b_i, s_i), val)
+                np.minimum.at(lo, (b_i, s_i), val)
+                if kb == n_steps:                                                  # the window's end
+                    hi, lo = np.maximum(hi, Y[:, -1]), np.minimum(lo, Y[:, -1])
+            for z in (z0, z_end):                                                  # the piece's ends
+                if z is not None:
+                    y = np.einsum("bkd,bd->bk", C, z)
+                    hi, lo = np.maximum(hi, y), np.minimum(lo, y)
+        return hi, lo
+
+    def _ay_rows(self, speed_mps: float, units):
+        """``signals`` of :meth:`_extremes`: the CG lateral accelerations of ``units`` (0-based)."""
+        co = system_coefficients(self.vehicle)
+        u = float(speed_mps)
+        Vmap, Rmap = co.velocity_map(u)[units], co.yaw_rate_map()[units]
+
+        def rows(Mz, d_row, ctx):
+            A_x, bd_x, n = ctx[0], ctx[1], ctx[3]
+            C = np.zeros((Mz.shape[0], len(units), Mz.shape[-1]))
+            C[:, :, :n] = np.einsum("kn,bnj->bkj", Vmap, A_x) + u * Rmap
+            da = np.einsum("kn,bn->bk", Vmap, bd_x[:, :n])
+            C += da[:, :, None] * (d_row if d_row.ndim == 1 else d_row[:, None, :])
+            return C
+        return rows
+
     def _ay_peaks(self, speed_mps: float, steer, t_end: float, dt: float, units, tire_scale: float,
                   rows: np.ndarray) -> np.ndarray:
+        units = list(range(self.vehicle.n_units)) if units is None else list(units)
+        hi, lo = self._extremes(speed_mps, steer, t_end, dt, self._ay_rows(speed_mps, units), tire_scale, rows)
+        return np.maximum(np.abs(hi), np.abs(lo))
+
+    def lane_change(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """(HSTO [m], the lane change's RA [-]) of every variant, as
+        :func:`lcvreport.analysis.field_measures.lane_change_measures` (the path-following lane
+        change through each variant's inverse system): the last unit's rearmost axle's largest
+        overshoot beyond the steered axle's final offset (0 if none), and max|a_N| / max|a_s|.
+        NaN where the inverse system is unstable or does not exist (measure_set's null)."""
+        from .exact import steered_point
+        from .field_measures import DT_S, G_MPS2, LANE_CHANGE, LANE_CHANGE_TAIL_S
+        from .geometry import point_lateral_map
+        from .manoeuvres import lane_change, lane_change_offset_m
         v = self.vehicle
-        co = system_coefficients(v)
+        B, nu, n = self.size, v.n_units, v.n_states
+        accel_g, f_hz = LANE_CHANGE
+        steer = lane_change(accel_g * G_MPS2, f_hz)
+        t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
+        offset = lane_change_offset_m(steer)
+        sign = 1.0 if offset >= 0 else -1.0
         u = float(speed_mps)
-        units = list(range(v.n_units)) if units is None else list(units)
-        n_steps = int(round(t_end / dt))
-        peak = np.zeros((rows.size, len(units)))
-        Vmap, Rmap = co.velocity_map(u)[units], co.yaw_rate_map()[units]
-        for Mz, z0, Z, z_end, ka, kb, d_row, (A_x, bd_x, m, n) in self._pieces(speed_mps, steer, t_end, dt,
-                                                                             tire_scale, rows):
-            C = np.zeros((rows.size, len(units), Mz.shape[-1]))                # ay rows over z
-            C[:, :, :n] = np.einsum("kn,bnj->bkj", Vmap, A_x) + u * Rmap
-            C += np.einsum("kn,bn->bk", Vmap, bd_x[:, :n])[:, :, None] * d_row
-            if Z is None:
+        xs = steered_point(v)
+        rear = v.units[-1].rearmost_axle
+        cmap = point_lateral_map(v, nu - 1, rear.x_m)
+        cum = np.zeros((nu - 1, n + 2))
+        for k in range(nu - 1):
+            cum[k, nu + 1:nu + 2 + k] = 1.0
+        y_row = cmap[2:] @ cum if nu > 1 else np.zeros(n + 2)
+        y_row[n] += cmap[0]
+        y_row[n + 1] += cmap[1]
+        ay_rows = self._ay_rows(u, [nu - 1])
+
+        def signals(Mz, d_row, ctx):
+            C = np.zeros((Mz.shape[0], 3, Mz.shape[-1]))
+            C[:, 0, :n + 2] = y_row                                             # Y of the rear axle
+            C[:, 1] = ay_rows(Mz, d_row, ctx)[:, 0]                             # a_N
+            C[:, 2] = Mz[:, 0] + xs * Mz[:, 1]                                  # a_s = v1' + x_s r1' + u r1
+            C[:, 2, 1] += u
+            return C
+        hsto, ra = np.full(B, np.nan), np.full(B, np.nan)
+        for g in range(0, B, 64):
+            rows = np.arange(g, min(B, g + 64))
+            ok = self._inverse_stable(u, tire_scale, rows)
+            rows = rows[ok]
+            if not rows.size:
                 continue
-            b_i, s_i, _t, val, Y = self._between_samples(Z, C, Mz, dt, ka * dt)
-            np.maximum.at(peak, (b_i, s_i), np.abs(val))
-            peak = np.maximum(peak, np.abs(np.einsum("bkd,bd->bk", C, z0)))      # the piece's ends
-            if z_end is not None:
-                peak = np.maximum(peak, np.abs(np.einsum("bkd,bd->bk", C, z_end)))
-            if kb == n_steps:                                                      # the window's end
-                peak = np.maximum(peak, np.abs(Y[:, -1]))
-        return peak
+            hi, lo = self._extremes(u, steer, t_end, DT_S, signals, tire_scale, rows)
+            over = (hi[:, 0] - offset) if sign > 0 else -(lo[:, 0] - offset)
+            hsto[rows] = np.maximum(0.0, over)
+            peak = np.maximum(np.abs(hi), np.abs(lo))
+            ra[rows] = peak[:, 1] / peak[:, 2]
+        return hsto, ra
+
+    def _inverse_stable(self, u: float, tire_scale: float, rows: np.ndarray) -> np.ndarray:
+        """Which variants of ``rows`` have a stable inverse system from the steered axle's
+        lateral acceleration to the steer (the test of :func:`lcvreport.analysis.exact.response`)."""
+        from .exact import steered_point
+        c = {k: a[rows] for k, a in self.coefficients.items()}
+        n = self.vehicle.n_states
+        M = c["M0"] + u * c["M1"]
+        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        AG = solve_scaled(M, np.concatenate([S, np.broadcast_to(np.eye(n), (rows.size, n, n))], axis=-1))
+        A_x, Minv = AG[..., :n], AG[..., n:]
+        b = np.einsum("bij,bj->bi", Minv, tire_scale * c["Bdelta"])
+        Js = np.zeros(n)
+        Js[0], Js[1] = 1.0, steered_point(self.vehicle)
+        Cs = np.einsum("k,bkj->bj", Js, A_x)
+        Cs[:, 1] += u
+        Ds = b @ Js
+        exists = np.abs(Ds) >= 1e-12 * np.maximum(1.0, np.abs(Cs).max(axis=1))
+        out = np.zeros(rows.size, bool)
+        if exists.any():
+            k = np.flatnonzero(exists)
+            zeros = np.linalg.eigvals(A_x[k] - b[k, :, None] * Cs[k, None, :] / Ds[k, None, None])
+            out[k] = zeros.real.max(axis=1) <= 1e-9 * np.maximum(1.0, np.abs(zeros).max(axis=1))
+        return out
 
     def yaw_damping(self, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
         """The yaw damping coefficient [-] of every variant
@@ -564,6 +677,7 @@ class VariantBatch:
         crit = self.critical_speed(tire_scale)
         peak, peak_f = self.ra_peak(speed_mps, tire_scale)
         hsso, turn_delta = self.steady_turn(speed_mps, tire_scale)
+        hsto, ra_lc = self.lane_change(speed_mps, tire_scale)
         table = {"case_id": np.arange(self.size)}
         table.update({name: np.asarray(arr, dtype=float) for name, arr in self.values.items()})
         table.update({"speed_mps": np.full(self.size, float(speed_mps)), "least_damping_ratio": zeta,
@@ -571,6 +685,7 @@ class VariantBatch:
                       "ra_frequency": self.rearward_amplification(speed_mps, f_hz, tire_scale),
                       "ra_single_sine": self.single_sine(speed_mps, f_hz, tire_scale),
                       "yaw_damping_coefficient": self.yaw_damping(speed_mps, tire_scale),
+                      "hsto_m": hsto, "ra_lane_change": ra_lc,
                       "ra_peak": peak, "ra_peak_frequency_hz": peak_f, "hsso_m": hsso,
                       "steady_turn_delta_rad": turn_delta})
         if F is not None:

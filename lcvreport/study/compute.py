@@ -34,6 +34,8 @@ def _batched(batch: VariantBatch, speed_mps: float, tire_scale: float, wanted: s
         out["ra_frequency"] = batch.rearward_amplification(speed_mps, RA_FREQUENCY_HZ, tire_scale)
     if "yaw_damping_coefficient" in wanted:
         out["yaw_damping_coefficient"] = batch.yaw_damping(speed_mps, tire_scale)
+    if wanted & {"hsto_m", "ra_lane_change"}:
+        out["hsto_m"], out["ra_lane_change"] = batch.lane_change(speed_mps, tire_scale)
     if "ra_single_sine" in wanted:
         out["ra_single_sine"] = batch.single_sine(speed_mps, RA_FREQUENCY_HZ, tire_scale)
     if wanted & {"ra_peak", "ra_peak_frequency_hz"}:

@@ -51,10 +51,10 @@ from ..units import kph_to_mps
 #: measures computed batched over the cases (lcvreport.analysis.batch); the others of
 #: ``lcv measures`` are computed case by case with measure_set (same numbers, slower)
 BATCHED = ("least_damping_ratio", "least_damped_frequency_hz", "critical_speed_kph", "ra_frequency",
-           "ra_single_sine", "ra_peak", "ra_peak_frequency_hz", "yaw_damping_coefficient", "hsso_m",
-           "steady_turn_delta_rad")
+           "ra_single_sine", "ra_peak", "ra_peak_frequency_hz", "yaw_damping_coefficient", "hsto_m",
+           "ra_lane_change", "hsso_m", "steady_turn_delta_rad")
 #: every measure a study can ask for: the scalar keys of ``lcv measures --json``
-MEASURES = BATCHED + ("hsto_m", "ra_lane_change", "lssp_m",
+MEASURES = BATCHED + ("lssp_m",
                       "low_speed_offtracking_m", "max_tail_swing_m", "frontal_swing_m")
 DEFAULT_MEASURES = BATCHED
 UNIT_SCALES = {"mass_scale": "mass_kg", "yaw_inertia_scale": "yaw_inertia_kg_m2"}
