@@ -222,3 +222,19 @@ def test_batched_lane_change_is_the_one_variant_lane_change(preset, speed):
         ref = lane_change_measures(_variant(v, values, i), speed)
         assert hsto[i] == pytest.approx(ref.hsto_m, rel=1e-12, abs=1e-12), i
         assert ra[i] == pytest.approx(ref.ra_lane_change, rel=1e-12), i
+
+
+def test_a_variant_with_an_unstable_inverse_system_has_no_lane_change():
+    """legal_max at 60 m/s has a right-half-plane zero (exact.response refuses the lane change,
+    measure_set reports null): its variants get NaN, the others their numbers."""
+    from lcvreport.analysis.exact import ManoeuvreError
+    from lcvreport.analysis.field_measures import lane_change_measures
+    v = load_preset("legal_max")
+    name = f"{v.units[0].name}.yaw_inertia_kg_m2"
+    values = {name: _nominal(v, name) * np.array([1.0, 1.0])}
+    hsto, ra = VariantBatch(v, values).lane_change(60.0)
+    with pytest.raises(ManoeuvreError, match="unstable"):
+        lane_change_measures(v, 60.0)
+    assert np.isnan(hsto).all() and np.isnan(ra).all()
+    hsto, _ra = VariantBatch(v, values).lane_change(20.0)
+    assert np.isfinite(hsto).all()
