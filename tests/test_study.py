@@ -263,3 +263,24 @@ def test_the_study_report(tmp_path):
     r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "out"), "--report", str(tmp_path / "rep2")],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "--report" in r.stderr and (tmp_path / "rep2" / "mine.txt").read_text() == "keep"
+
+
+def test_an_existing_scheduler_runs_the_study(tmp_path):
+    """--scheduler ADDRESS: a cluster started elsewhere (here by the test) computes the chunks;
+    the results equal the in-process run bit for bit.  A scheduler that does not answer: one
+    line, exit 2."""
+    from dask.distributed import LocalCluster
+    doc = dict(SMALL, measures=["least_damping_ratio", "ra_peak"], design={"kind": "random", "count": 40, "seed": 2},
+               chunk_size=10)
+    path = _write(tmp_path, doc)
+    run_study(study_from_dict(doc), tmp_path / "ref")
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "out"), "--scheduler",
+                                  cluster.scheduler_address, "--json"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["chunks_computed"] == 4
+    assert read_study(tmp_path / "out").equals(read_study(tmp_path / "ref"))
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "out2"), "--scheduler",
+                              "tcp://127.0.0.1:9"], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "no Dask scheduler answers" in r.stderr, \
+        r.stderr
