@@ -284,3 +284,34 @@ def test_an_existing_scheduler_runs_the_study(tmp_path):
                               "tcp://127.0.0.1:9"], capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "no Dask scheduler answers" in r.stderr, \
         r.stderr
+
+
+def test_a_progress_bar_on_a_terminal_and_none_otherwise(tmp_path):
+    """On a terminal (a pseudo-terminal 100 columns wide) the bar shows cases, cases/s and the
+    ETA on standard error; into a pipe nothing but the summary."""
+    import fcntl
+    import pty
+    import struct
+    import termios
+    path = _write(tmp_path, dict(SMALL, measures=["least_damping_ratio"], design={"kind": "random", "count": 200,
+                                                                                "seed": 1}, chunk_size=20))
+    pid, fd = pty.fork()
+    if pid == 0:                                          # the child: lcv on the terminal
+        os.execv(sys.executable, [sys.executable, "-m", "lcvreport.cli", "study", str(path), "--out",
+                                  str(tmp_path / "tty")])
+    fcntl.ioctl(fd, termios.TIOCSWINSZ, struct.pack("HHHH", 40, 100, 0, 0))
+    chunks = []
+    try:
+        while True:
+            data = os.read(fd, 4096)
+            if not data:
+                break
+            chunks.append(data)
+    except OSError:
+        pass
+    _, status = os.waitpid(pid, 0)
+    text = b"".join(chunks).decode(errors="replace")
+    assert os.WEXITSTATUS(status) == 0, text
+    assert "cases: 100%" in text and "case/s" in text and "200/200" in text, text
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "pipe")], capture_output=True, text=True)
+    assert r.returncode == 0 and r.stderr == "" and "case/s" not in r.stdout
