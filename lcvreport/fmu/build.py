@@ -424,6 +424,39 @@ def _package_copy(dst: Path, name: str = "lcvreport") -> None:
         "__pycache__", "*.pyc", "fmu_src", "notebooks", "report", "thesis", "cli.py", "build.py", "data/thesis"))
 
 
+def _pythonfmu_build(tool: str, itf: Interface, tmp: Path, alias: str, script: str, script_text: str,
+                     model_identifier: str, binary_dir: str) -> tuple[dict, bytes]:
+    """A pythonfmu (``tool="pythonfmu"``) or pythonfmu3 project in ``tmp/project`` -- the slave
+    script, ``lcv_fmu.json``, the vehicle file, the package bundled as ``alias`` -- built with
+    the tool; the FMU's files without its binaries, and the tool's export library for Linux."""
+    proj = tmp / "project"
+    proj.mkdir()
+    (proj / script).write_text(script_text, encoding="utf-8")
+    cfg = {"mode": "presets"} if itf.preset_mode else {
+        "mode": "vehicle", "vehicle_file": "vehicle.toml",
+        "u_start_mps": next(v.start for v in itf.variables if v.name == "u")}
+    (proj / "lcv_fmu.json").write_text(json.dumps(cfg), encoding="utf-8")
+    extra = [proj / "lcv_fmu.json"]
+    if not itf.preset_mode:
+        (proj / "vehicle.toml").write_text(dumps_vehicle(itf.vehicles[0]), encoding="utf-8")
+        extra.append(proj / "vehicle.toml")
+    _package_copy(proj, alias)
+    built = tmp / "built"
+    cmd = [sys.executable, "-m", tool, "build", "-f", str(proj / script), "-d", str(built),
+           "--handle-state", "--serialize-state", *map(str, extra), str(proj / alias)]
+    env_build = dict(os.environ, PYTHONPATH=str(proj) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    p = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp, env=env_build)
+    fmu = built / f"{model_identifier}.fmu"
+    if p.returncode != 0 or not fmu.exists():
+        raise FmuBuildError(f"{tool} build failed:\n{p.stdout[-2000:]}\n{p.stderr[-4000:]}")
+    with zipfile.ZipFile(fmu) as zf:
+        files = {n: zf.read(n) for n in zf.namelist() if not n.endswith("/")}
+    export = files.pop(f"binaries/{binary_dir}/{model_identifier}.so")
+    for name in [n for n in files if n.startswith("binaries/")]:
+        files.pop(name)   # the tool's Windows and macOS libraries: the loaders are Linux-only
+    return files, export
+
+
 def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: dict | None = None) -> Path:
     """Build the pythonfmu FMU ``<model_identifier>.fmu`` with the loader as its binary."""
     out_dir = Path(out_dir).resolve()
@@ -434,36 +467,14 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
     src = source_dir()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        proj = tmp / "project"
-        proj.mkdir()
         alias = bundled_package_name(fmu_guid)
         slave_text = (src / "LCV.py").read_text(encoding="utf-8")
         if "from lcvreport.fmu.slave import LCV" not in slave_text:
             raise FmuBuildError("fmu_src/LCV.py lost its import line")
-        (proj / "LCV.py").write_text(slave_text.replace("from lcvreport.fmu.slave import LCV",
-                                                        f"from {alias}.fmu.slave import LCV"), encoding="utf-8")
-        cfg = {"mode": "presets"} if itf.preset_mode else {
-            "mode": "vehicle", "vehicle_file": "vehicle.toml",
-            "u_start_mps": next(v.start for v in itf.variables if v.name == "u")}
-        (proj / "lcv_fmu.json").write_text(json.dumps(cfg), encoding="utf-8")
-        extra = [proj / "lcv_fmu.json"]
-        if not itf.preset_mode:
-            (proj / "vehicle.toml").write_text(dumps_vehicle(itf.vehicles[0]), encoding="utf-8")
-            extra.append(proj / "vehicle.toml")
-        _package_copy(proj, alias)
-        built = tmp / "built"
-        cmd = [sys.executable, "-m", "pythonfmu", "build", "-f", str(proj / "LCV.py"), "-d", str(built),
-               "--handle-state", "--serialize-state", *map(str, extra), str(proj / alias)]
-        env_build = dict(os.environ, PYTHONPATH=str(proj) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-        p = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp, env=env_build)
-        fmu = built / f"{model_identifier}.fmu"
-        if p.returncode != 0 or not fmu.exists():
-            raise FmuBuildError(f"pythonfmu build failed:\n{p.stdout[-2000:]}\n{p.stderr[-4000:]}")
-        with zipfile.ZipFile(fmu) as zf:
-            files = {n: zf.read(n) for n in zf.namelist() if not n.endswith("/")}
-        export = files.pop(f"binaries/linux64/{model_identifier}.so")
-        for name in [n for n in files if n.startswith("binaries/")]:
-            files.pop(name)   # pythonfmu's Windows and macOS libraries: the loader is Linux-only
+        files, export = _pythonfmu_build("pythonfmu", itf, tmp, alias, "LCV.py",
+                                         slave_text.replace("from lcvreport.fmu.slave import LCV",
+                                                            f"from {alias}.fmu.slave import LCV"),
+                                         model_identifier, "linux64")
         files["modelDescription.xml"] = model_description(itf, model_identifier, native=False,
                                                           generation_tool="lcvreport.fmu.build (pythonfmu 0.7.0)")
         (tmp / "loader_config.h").write_text(loader_config_header(itf, model_identifier, fmu_guid, env), "utf-8")
@@ -507,34 +518,12 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
     src = source_dir()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        proj = tmp / "project"
-        proj.mkdir()
         alias = bundled_package_name(fmu_guid)
         module = "lcv_slave3_" + alias.rsplit("_", 1)[1]      # unique per FMU: pythonfmu3 imports it by name
-        (proj / f"{module}.py").write_text(SLAVE3_TEMPLATE.format(alias=alias, cls="LCVSlave3",
-                                                                  identifier=model_identifier), encoding="utf-8")
-        cfg = {"mode": "presets"} if itf.preset_mode else {
-            "mode": "vehicle", "vehicle_file": "vehicle.toml",
-            "u_start_mps": next(v.start for v in itf.variables if v.name == "u")}
-        (proj / "lcv_fmu.json").write_text(json.dumps(cfg), encoding="utf-8")
-        extra = [proj / "lcv_fmu.json"]
-        if not itf.preset_mode:
-            (proj / "vehicle.toml").write_text(dumps_vehicle(itf.vehicles[0]), encoding="utf-8")
-            extra.append(proj / "vehicle.toml")
-        _package_copy(proj, alias)
-        built = tmp / "built"
-        cmd = [sys.executable, "-m", "pythonfmu3", "build", "-f", str(proj / f"{module}.py"), "-d", str(built),
-               "--handle-state", "--serialize-state", *map(str, extra), str(proj / alias)]
-        env_build = dict(os.environ, PYTHONPATH=str(proj) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-        p = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp, env=env_build)
-        fmu = built / f"{model_identifier}.fmu"
-        if p.returncode != 0 or not fmu.exists():
-            raise FmuBuildError(f"pythonfmu3 build failed:\n{p.stdout[-2000:]}\n{p.stderr[-4000:]}")
-        with zipfile.ZipFile(fmu) as zf:
-            files = {n: zf.read(n) for n in zf.namelist() if not n.endswith("/")}
-        export = files.pop(f"binaries/x86_64-linux/{model_identifier}.so")
-        for name in [n for n in files if n.startswith("binaries/")]:
-            files.pop(name)   # pythonfmu3's Windows library: the loader is Linux-only
+        files, export = _pythonfmu_build("pythonfmu3", itf, tmp, alias, f"{module}.py",
+                                         SLAVE3_TEMPLATE.format(alias=alias, cls="LCVSlave3",
+                                                                identifier=model_identifier),
+                                         model_identifier, "x86_64-linux")
         files["modelDescription.xml"] = model_description3(itf, model_identifier, native=False,
                                                            generation_tool="lcvreport.fmu.build (pythonfmu3 0.3.4)")
         from .model_description3 import time_value_reference

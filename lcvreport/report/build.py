@@ -645,26 +645,35 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         intro = (f"Linear yaw-plane model of *{vehicle.name}* ({vehicle.n_units} units: "
                  f"{', '.join(vehicle.unit_names)}){' from ' + source if source else ''}, assessed at {speed_kph:g} km/h "
                  f"(SI units; speeds in km/h). Written by lcvreport {__version__} on {stamp}.")
-        nb = merge([("assessment", "assessment", title, path)], title, intro)
-        html = export_html(nb, staged)
-        progress("html written")
-        written = {"html": "index.html", "data": "data"}
-        if pdf:
-            export_pdf(nb, staged, f"lcvreport {__version__} assessment of {vehicle.name}", paper=paper,
-                       title_page=False)
-            written["pdf"] = "report.pdf"
-            progress("pdf written")
-        files = sorted(p.name for p in staged.iterdir()) + [MANIFEST]
-        (staged / MANIFEST).write_text(json.dumps({"written_by": f"lcvreport {__version__} (lcv report)",
-                                                   "files": files}, indent=1), encoding="utf-8")
-        _publish(staged, out, before)
+        written = _finish_single(staged, out, before, ("assessment", "assessment", title, path), title, intro,
+                                 pdf, f"lcvreport {__version__} assessment of {vehicle.name}", paper,
+                                 f"lcvreport {__version__} (lcv report)", progress)
     except BaseException:
         shutil.rmtree(staged, ignore_errors=True)
         raise
     res = {key: out / name for key, name in written.items()}
     res["seconds"] = time.perf_counter() - t0
-    del html
     return res
+
+
+def _finish_single(staged: Path, out: Path, before, part: tuple, title: str, intro: str, pdf: bool, pdf_title: str,
+                   paper: str, written_by: str, progress) -> dict:
+    """The end of a one-notebook report (the assessment, a study): merge, HTML, PDF, the
+    manifest, then the staged folder published into ``out``; the files written, by kind."""
+    import json
+    nb = merge([part], title, intro)
+    export_html(nb, staged)
+    progress("html written")
+    written = {"html": "index.html", "data": "data"}
+    if pdf:
+        export_pdf(nb, staged, pdf_title, paper=paper, title_page=False)
+        written["pdf"] = "report.pdf"
+        progress("pdf written")
+    files = sorted(p.name for p in staged.iterdir()) + [MANIFEST]
+    (staged / MANIFEST).write_text(json.dumps({"written_by": written_by, "files": files}, indent=1),
+                                   encoding="utf-8")
+    _publish(staged, out, before)
+    return written
 
 
 def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf: bool = True,
@@ -714,19 +723,9 @@ def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf
         intro = (f"The results of `lcv study` in {study_dir.name}: {study.n_cases} cases of *{study.vehicle.name}*, "
                  f"measures {', '.join(study.measures)} (SI units; speeds in km/h). Written by lcvreport "
                  f"{__version__} on {stamp}.")
-        nb = merge([("study", "study", title, path)], title, intro)
-        export_html(nb, staged)
-        progress("html written")
-        written = {"html": "index.html", "data": "data"}
-        if pdf:
-            export_pdf(nb, staged, f"lcvreport {__version__} study of {study.vehicle.name}", paper=paper,
-                       title_page=False)
-            written["pdf"] = "report.pdf"
-            progress("pdf written")
-        files = sorted(p.name for p in staged.iterdir()) + [MANIFEST]
-        (staged / MANIFEST).write_text(json.dumps({"written_by": f"lcvreport {__version__} (lcv study --report)",
-                                                   "files": files}, indent=1), encoding="utf-8")
-        _publish(staged, out, before)
+        written = _finish_single(staged, out, before, ("study", "study", title, path), title, intro, pdf,
+                                 f"lcvreport {__version__} study of {study.vehicle.name}", paper,
+                                 f"lcvreport {__version__} (lcv study --report)", progress)
     except BaseException:
         shutil.rmtree(staged, ignore_errors=True)
         raise
