@@ -305,25 +305,7 @@ static fmi3Status no_variables(fmi3Instance instance, size_t nvr, const char *fu
     return fmi3Error;
 }
 
-#define NO_GET(T, CT) \
-fmi3Status fmi3Get##T(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences, \
-                      CT values[], size_t nValues) \
-{ (void)valueReferences; (void)values; (void)nValues; \
-  return no_variables(instance, nValueReferences, "fmi3Get" #T, #T); }
-#define NO_SET(T, CT) \
-fmi3Status fmi3Set##T(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences, \
-                      const CT values[], size_t nValues) \
-{ (void)valueReferences; (void)values; (void)nValues; \
-  return no_variables(instance, nValueReferences, "fmi3Set" #T, #T); }
-NO_GET(Float32, fmi3Float32) NO_SET(Float32, fmi3Float32)
-NO_GET(Int8, fmi3Int8) NO_SET(Int8, fmi3Int8)
-NO_GET(UInt8, fmi3UInt8) NO_SET(UInt8, fmi3UInt8)
-NO_GET(Int16, fmi3Int16) NO_SET(Int16, fmi3Int16)
-NO_GET(UInt16, fmi3UInt16) NO_SET(UInt16, fmi3UInt16)
-NO_GET(Int32, fmi3Int32) NO_SET(Int32, fmi3Int32)
-NO_GET(UInt32, fmi3UInt32) NO_SET(UInt32, fmi3UInt32)
-NO_GET(UInt64, fmi3UInt64) NO_SET(UInt64, fmi3UInt64)
-NO_GET(Boolean, fmi3Boolean) NO_SET(Boolean, fmi3Boolean)
+#include "fmi3_no_variables.h"     /* fmi3Get/Set of the types this FMU has no variables of */
 
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
                          size_t valueSizes[], fmi3Binary values[], size_t nValues)

@@ -50,7 +50,7 @@ CFLAGS = ["-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Wall",
 #: C sources of the native FMU (fmu_src/c) and of its interface-only twin
 NATIVE_SOURCES = ("fmi2_api.c", "fmi2_shared.c", "model.c", "linalg.c")
 STUB_SOURCES = ("fmi2_api.c", "fmi2_shared.c", "model_stub.c")
-C_HEADERS = ("fmi2_shared.h", "model.h", "linalg.h", "vehicle.h")
+C_HEADERS = ("fmi2_shared.h", "model.h", "linalg.h", "vehicle.h", "fmi3_no_variables.h")
 #: the official FMI 2.0 headers (from fmpy's package)
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 #: name of pythonfmu's export library inside a pythonfmu FMU (the loader loads it)
@@ -537,7 +537,8 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
                  ["-ldl", "-lpthread"], defines=["LCV_FMI3"])
         files[f"binaries/x86_64-linux/{model_identifier}.so"] = loader.read_bytes()
         files[f"binaries/x86_64-linux/{EXPORT_LIB3}"] = export
-        for name in ("loader3.c", "pyruntime.c", "pyruntime.h", "fmi2_shared.c", "fmi2_shared.h"):
+        for name in ("loader3.c", "pyruntime.c", "pyruntime.h", "fmi2_shared.c", "fmi2_shared.h",
+                     "fmi3_no_variables.h"):
             files[f"sources/{name}"] = (src / "c" / name).read_bytes()
         files["sources/loader_config.h"] = (tmp / "loader_config.h").read_bytes()
         doc = documentation_files(itf, model_identifier, native=False)
