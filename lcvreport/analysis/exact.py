@@ -137,39 +137,53 @@ class ManoeuvreResponse:
         """Times [s] and values of the local extrema of signal ``name`` in ``[t_from,
         t_to]`` on the continuous response, plus the values at the ends of that window
         and at the input's breakpoints (where the derivative may jump)."""
-        j = self._index(name)
-        times, values = [], []
+        return self.extrema_many([name], t_from, t_to)[0]
+
+    def extrema_many(self, names, t_from: float = 0.0, t_to: float = math.inf) -> list:
+        """:meth:`extrema` of several signals at once (one product per piece for all of them):
+        a list of (times, values), in the order of ``names``."""
+        js = [self._index(n) for n in names]
+        K = len(js)
+        times = [[] for _ in js]
+        values = [[] for _ in js]
         for seg in self.segments:
-            c = seg.C[j]
-            c1 = c @ seg.Mz
-            c2 = c1 @ seg.Mz
             t = self.time[seg.k0:seg.k0 + len(seg.Z)]
             if t.size == 0:
                 continue
-            y, d1, d2 = (seg.Z @ np.column_stack([c, c1, c2])).T      # one product for the three
+            c = seg.C[js].T                                   # (dim, K)
+            c1 = seg.Mz.T @ c
+            c2 = seg.Mz.T @ c1
+            Y = seg.Z @ np.concatenate([c, c1, c2], axis=1)   # one product for all: (samples, 3K)
             dt = t[1] - t[0] if t.size > 1 else 0.0
-            # a sign change of the derivative, or a zero of it at a sample (not a flat stretch)
-            change = np.flatnonzero(((d1[:-1] > 0) != (d1[1:] > 0)) & ((d1[:-1] != 0) | (d1[1:] != 0)))
-            change = change[(t[change + 1] >= t_from) & (t[change] <= t_to)]
-            if change.size:
-                k, k1 = change, change + 1
-                tau = _hermite_roots(d1[k], d2[k], d1[k1], d2[k1], dt)
-                tk = t[k] + tau * dt
-                val = _quintic(y[k], d1[k], d2[k], y[k1], d1[k1], d2[k1], dt, tau)
-                keep = (tk >= t_from) & (tk <= t_to)
-                times.extend(tk[keep].tolist())
-                values.extend(val[keep].tolist())
-            # the ends of the window and the piece's own ends
+            for s in range(K):
+                y, d1, d2 = Y[:, s], Y[:, K + s], Y[:, 2 * K + s]
+                # a sign change of the derivative, or a zero of it at a sample (not a flat stretch)
+                change = np.flatnonzero(((d1[:-1] > 0) != (d1[1:] > 0)) & ((d1[:-1] != 0) | (d1[1:] != 0)))
+                change = change[(t[change + 1] >= t_from) & (t[change] <= t_to)]
+                if change.size:
+                    k, k1 = change, change + 1
+                    tau = _hermite_roots(d1[k], d2[k], d1[k1], d2[k1], dt)
+                    tk = t[k] + tau * dt
+                    val = _quintic(y[k], d1[k], d2[k], y[k1], d1[k1], d2[k1], dt, tau)
+                    keep = (tk >= t_from) & (tk <= t_to)
+                    times[s].extend(tk[keep].tolist())
+                    values[s].extend(val[keep].tolist())
+            # the piece's own ends
             for tb, zb in ((seg.t0, seg.z_start), (seg.t1, seg.z_end)):
                 if zb is not None and t_from <= tb <= t_to and math.isfinite(tb):
-                    times.append(tb)
-                    values.append(float(zb @ c))
-        for tb in (t_from, min(t_to, self.time[-1])):
-            if self.time[0] <= tb <= self.time[-1]:
-                times.append(tb)
-                values.append(self.value_at(name, tb))
-        order = np.argsort(times)
-        return np.asarray(times)[order], np.asarray(values)[order]
+                    vb = zb @ c
+                    for s in range(K):
+                        times[s].append(tb)
+                        values[s].append(float(vb[s]))
+        out = []
+        for s, name in enumerate(names):                      # the ends of the window
+            for tb in (t_from, min(t_to, self.time[-1])):
+                if self.time[0] <= tb <= self.time[-1]:
+                    times[s].append(tb)
+                    values[s].append(self.value_at(name, tb))
+            order = np.argsort(times[s])
+            out.append((np.asarray(times[s])[order], np.asarray(values[s])[order]))
+        return out
 
     def value_at(self, name: str, t: float) -> float:
         """The exact value of signal ``name`` at time ``t`` [s] (within the sampled span)."""
@@ -191,6 +205,10 @@ class ManoeuvreResponse:
         """max |signal| over ``[t_from, t_to]`` on the continuous response."""
         _t, v = self.extrema(name, t_from, t_to)
         return float(np.abs(v).max())
+
+    def peaks_abs(self, names, t_from: float = 0.0, t_to: float = math.inf) -> np.ndarray:
+        """:meth:`peak_abs` of several signals at once."""
+        return np.array([float(np.abs(v).max()) for _t, v in self.extrema_many(names, t_from, t_to)])
 
     def plot(self, signals: list[str] | None = None, ax=None):
         """Plot signals against time (default: the steer and every unit's ay)."""

@@ -173,8 +173,7 @@ def yaw_damping_coefficient(vehicle: Vehicle, speed_mps: float, tire_scale: floa
     if vehicle.n_units < 2:
         return YawDamping(None, [], [], [], zeta_modal, r, "a single unit has no articulation joint")
     per_joint, amps, ext = [], [], []
-    for name in vehicle.state_names[vehicle.n_units + 1:]:
-        t, v = r.extrema(name, D, D + YDC_WINDOW_S)
+    for t, v in r.extrema_many(vehicle.state_names[vehicle.n_units + 1:], D, D + YDC_WINDOW_S):
         inner = (t > D + 1e-12) & (t < D + YDC_WINDOW_S - 1e-12)     # the window's ends are not extrema
         t, v = t[inner], v[inner]
         ext.append((t, v))
@@ -218,9 +217,9 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
     rear = vehicle.units[-1].rearmost_axle.name
     steered = max(vehicle.steered_axles, key=lambda a: a.x_m).name
     sign = 1.0 if offset >= 0 else -1.0
-    _t, Y = r.extrema(f"Y_{rear}")
+    (_t, Y), (_ta, a_n), (_ts, a_s) = r.extrema_many([f"Y_{rear}", f"ay{vehicle.n_units}", "a_steer"])
     hsto = max(0.0, float(np.max(sign * (Y - offset))))
-    ra = r.peak_abs(f"ay{vehicle.n_units}") / r.peak_abs("a_steer")
+    ra = float(np.abs(a_n).max()) / float(np.abs(a_s).max())
     return LaneChangeMeasures(hsto, float(ra), offset, r, rear, steered)
 
 

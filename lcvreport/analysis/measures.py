@@ -219,7 +219,7 @@ def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_H
     r = response(vehicle, speed_mps, steer, t_end, step_s, tire_scale=tire_scale)
     names = [f"ay{i + 1}" for i in range(vehicle.n_units)]
     ay = np.column_stack([r[n] for n in names])
-    peaks = np.array([r.peak_abs(n) for n in names])
+    peaks = r.peaks_abs(names)
     return SingleSine(r.time, r["delta"], ay, f, float(delta0_rad), float(speed_mps), vehicle, peaks)
 
 
