@@ -398,9 +398,9 @@ class VariantBatch:
         from .exact import _hermite_roots, _quintic
         C1 = C @ Mz
         C2 = C1 @ Mz
-        Y = Z @ np.swapaxes(C, 1, 2)
-        D1 = Z @ np.swapaxes(C1, 1, 2)
-        D2 = Z @ np.swapaxes(C2, 1, 2)
+        K = C.shape[1]
+        W = Z @ np.swapaxes(np.concatenate([C, C1, C2], axis=1), 1, 2)      # one product: (B, count, 3K)
+        Y, D1, D2 = W[..., :K], W[..., K:2 * K], W[..., 2 * K:]
         change = ((D1[:, :-1] > 0) != (D1[:, 1:] > 0)) & ((D1[:, :-1] != 0) | (D1[:, 1:] != 0))
         b_i, k_i, s_i = np.nonzero(change)
         if not b_i.size:
