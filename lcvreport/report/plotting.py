@@ -922,7 +922,9 @@ STUDY_UNITS = {"speed_kph": "km/h", "speed_mps": "m/s", "least_damping_ratio": "
 
 
 def _study_label(name: str) -> str:
-    return f"{name.replace('.', chr(10))} [{STUDY_UNITS.get(name, '1')}]"
+    """``trailer3.cornering_stiffness_scale`` -> three short lines and the unit (panels are narrow)."""
+    text = name.replace(".", "\n").replace("_stiffness_", "_stiffness\n")
+    return f"{text} [{STUDY_UNITS.get(name, '1')}]"
 
 
 def fig_study_scatter(table, factors: list[str], measures: list[str], max_points: int = 2000,
@@ -977,7 +979,8 @@ def study_pass_rates(rates) -> Figure:
         if j == 0:
             ax.set_ylabel("cases passing [%]", fontsize=SMALL_PT)
     if factors and rates.by_factor[factors[0]][1]:
-        axes[0][0].legend(fontsize=SMALL_PT, loc="lower left")
+        handles, labels = axes[0][0].get_legend_handles_labels()
+        fig.legend(handles, labels, fontsize=SMALL_PT, loc="outside lower center", ncol=min(5, len(labels)))
     return fig
 
 
