@@ -210,3 +210,31 @@ def test_valgrind_memcheck_one_million_steps_of_the_c_fmu(c_host, native_fmu, tm
                        capture_output=True, text=True, timeout=3000)
     assert p.returncode == 0, p.stderr[-3000:]
     assert "ERROR SUMMARY: 0 errors" in p.stderr and "All heap blocks were freed" in p.stderr
+
+
+def _threads_of_a_c_host_running(c_host, fmu_dir, guid, vr, env) -> int:
+    """The number of threads of a plain C host that has initialized LCV.fmu and taken a step."""
+    import os
+    p = subprocess.Popen([str(c_host), str(fmu_dir), "LCV", guid, "script"], stdin=subprocess.PIPE,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        p.stdin.write(f"s {vr['delta']} 0.01\ni\nd 0 0.01\n")
+        p.stdin.flush()
+        for _ in range(3):
+            assert p.stdout.readline().startswith("status 0")
+        return len(os.listdir(f"/proc/{p.pid}/task"))
+    finally:
+        p.stdin.close()
+        p.kill()
+        p.wait()
+
+
+def test_the_python_fmus_own_interpreter_runs_one_blas_thread(c_host, lcv_fmu, tmp_path):
+    """In a C host the FMU starts its own Python, whose numpy loads OpenBLAS with one thread by
+    default: a host with LCV_BLAS_THREADS=2 has exactly one thread more (OpenBLAS's second)."""
+    fmu_dir, guid, vr = unzip(lcv_fmu, tmp_path / "lcv")
+    clean = {k: v for k, v in host_env().items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                                              "MKL_NUM_THREADS", "LCV_BLAS_THREADS")}
+    default = _threads_of_a_c_host_running(c_host, fmu_dir, guid, vr, clean)
+    two = _threads_of_a_c_host_running(c_host, fmu_dir, guid, vr, dict(clean, LCV_BLAS_THREADS="2"))
+    assert two == default + 1, (default, two)
