@@ -96,17 +96,31 @@ def test_grid_order_and_design_reproducibility():
     a = study_from_dict(SMALL).factor_table(range(12))
     b = study_from_dict(SMALL).factor_table(range(12))
     assert all(np.array_equal(a[k], b[k]) for k in a)
-    rng = np.random.default_rng(7)                     # the documented draw order: factor by factor
-    assert np.array_equal(a["speed_kph"], np.array([70.0, 95.0])[rng.integers(0, 2, 12)])
-    assert np.array_equal(a["trailer3.mass_scale"], rng.uniform(0.6, 1.1, 12))
+    # the documented draws: per factor (file order) and block of 4096 cases, default_rng([seed, factor, block])
+    assert np.array_equal(a["speed_kph"], np.array([70.0, 95.0])[np.random.default_rng([7, 0, 0]).integers(0, 2, 12)])
+    assert np.array_equal(a["trailer3.mass_scale"], np.random.default_rng([7, 1, 0]).uniform(0.6, 1.1, 12))
+    big = study_from_dict(dict(SMALL, design={"kind": "random", "count": 3 * 4096 + 5, "seed": 7}))
+    ids = np.array([4095, 4096, 12290, 3])                 # across blocks, any order: the same as the whole
+    whole = big.factor_table(np.arange(big.n_cases))
+    part = big.factor_table(ids)
+    assert all(np.array_equal(part[k], whole[k][ids]) for k in whole)
+    assert np.array_equal(whole["trailer3.mass_scale"][4096:8192],
+                          np.random.default_rng([7, 1, 1]).uniform(0.6, 1.1, 4096))
 
 
 def test_two_local_workers_give_the_in_process_results_bit_for_bit(tmp_path):
+    """lcv study in process and on 2 workers: the same numbers to the bit.  (Both run BLAS with
+    one thread, lcv's default and the workers'; a product split over two BLAS threads may round
+    differently, so this runs lcv itself rather than run_study inside the test process.)"""
     doc = dict(SMALL, measures=list(MEASURES[:8]), design={"kind": "random", "count": 60, "seed": 11},
                chunk_size=10)
-    study = study_from_dict(doc)
-    run_study(study, tmp_path / "a")
-    run_study(study, tmp_path / "b", workers=2)
+    path = _write(tmp_path, doc)
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                                            "MKL_NUM_THREADS", "LCV_BLAS_THREADS")}
+    for out, extra in (("a", []), ("b", ["--workers", "2"])):
+        r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / out)] + extra, capture_output=True,
+                           text=True, env=env)
+        assert r.returncode == 0, r.stderr
     a, b = read_study(tmp_path / "a"), read_study(tmp_path / "b")
     assert a.equals(b)
     assert a[MEASURES[:8][0]].notna().all()
@@ -269,12 +283,17 @@ def test_an_existing_scheduler_runs_the_study(tmp_path):
     """--scheduler ADDRESS: a cluster started elsewhere (here by the test) computes the chunks;
     the results equal the in-process run bit for bit.  A scheduler that does not answer: one
     line, exit 2."""
+    import dask
     from dask.distributed import LocalCluster
+    from lcvreport.study.run import WORKER_CONFIG
     doc = dict(SMALL, measures=["least_damping_ratio", "ra_peak"], design={"kind": "random", "count": 40, "seed": 2},
                chunk_size=10)
     path = _write(tmp_path, doc)
-    run_study(study_from_dict(doc), tmp_path / "ref")
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "ref")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    with dask.config.set(WORKER_CONFIG):                 # workers with one BLAS thread, as lcv's own
+        cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None)
+    with cluster:
         r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "out"), "--scheduler",
                                   cluster.scheduler_address, "--json"], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr

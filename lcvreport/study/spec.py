@@ -21,8 +21,9 @@ tire coefficient), and scale factors ``<unit>.mass_scale``, ``<unit>.yaw_inertia
 ``.longitudinal_stiffness_scale`` (a unit name scales all its axles).  A factor has ``values``
 (a grid, or in a random design drawn with equal chance), or a ``distribution``: ``uniform``
 (``low``, ``high``) or ``normal`` (``mean``, ``sd``).  Cases are numbered from 0 in design order:
-the grid in the factors' file order (the last factor fastest), random draws factor by factor
-from one ``numpy.random.default_rng(seed)``.
+the grid in the factors' file order (the last factor fastest); random draws per factor and per
+block of 4,096 cases from ``numpy.random.default_rng([seed, factor index, block])``, so any
+chunk's cases are drawn without drawing the whole design.
 
 Examples
 --------
@@ -39,7 +40,7 @@ import itertools
 import json
 import math
 import tomllib
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -63,6 +64,8 @@ AXLE_SCALES = {"cornering_stiffness_scale": "cornering_stiffness_N_per_rad",
                "longitudinal_stiffness_scale": "longitudinal_stiffness_N"}
 PLAIN_FACTORS = ("speed_kph", "speed_mps", "tire_scale")
 MAX_CASES = 10_000_000
+#: cases per block of random draws (each block, each factor its own generator)
+DRAW_BLOCK = 4096
 
 
 class StudyError(ValueError):
@@ -101,7 +104,6 @@ class Study:
     seed: int | None = None
     speed_kph: float | None = None
     chunk_size: int = 0
-    _random: dict = field(default=None, repr=False, compare=False)
 
     # ------------------------------------------------------------------ cases
     @property
@@ -123,23 +125,44 @@ class Study:
     def n_chunks(self) -> int:
         return math.ceil(self.n_cases / self.chunk)
 
-    def _draws(self) -> dict:
-        if self._random is None:
-            rng = np.random.default_rng(self.seed)
-            out = {}
-            for f in self.factors:
-                if f.values:
-                    out[f.name] = np.asarray(f.values, dtype=float)[rng.integers(0, len(f.values), self.count)]
-                elif f.distribution == "uniform":
-                    out[f.name] = rng.uniform(f.low, f.high, self.count)
-                else:
-                    out[f.name] = rng.normal(f.mean, f.sd, self.count)
-                bad = np.flatnonzero(~(out[f.name] > 0))
+    def _block(self, factor_index: int, block: int) -> np.ndarray:
+        """The draws of one factor for the cases of one block (``DRAW_BLOCK`` cases), from
+        ``numpy.random.default_rng([seed, factor_index, block])``: any case's values are drawn
+        without drawing the whole design (a chunk of 10^7 cases costs its own cases only)."""
+        f = self.factors[factor_index]
+        n = min(DRAW_BLOCK, self.count - block * DRAW_BLOCK)
+        rng = np.random.default_rng([self.seed, factor_index, block])
+        if f.values:
+            return np.asarray(f.values, dtype=float)[rng.integers(0, len(f.values), n)]
+        if f.distribution == "uniform":
+            return rng.uniform(f.low, f.high, n)
+        return rng.normal(f.mean, f.sd, n)
+
+    def _draws(self, ids: np.ndarray) -> dict:
+        """Every factor's draws for the cases ``ids`` of a random design."""
+        out = {}
+        blocks = np.unique(ids // DRAW_BLOCK)
+        for i, f in enumerate(self.factors):
+            values = np.empty(ids.size)
+            for b in blocks:
+                sel = ids // DRAW_BLOCK == b
+                values[sel] = self._block(i, int(b))[ids[sel] - b * DRAW_BLOCK]
+            out[f.name] = values
+        return out
+
+    def check_draws(self) -> None:
+        """Refuse a random design that draws a value <= 0 (a normal distribution too wide),
+        naming the factor and the first such case; block by block, in constant memory."""
+        for i, f in enumerate(self.factors):
+            if f.distribution != "normal":
+                continue
+            for b in range(math.ceil(self.count / DRAW_BLOCK)):
+                draws = self._block(i, b)
+                bad = np.flatnonzero(~(draws > 0))
                 if bad.size:
-                    raise StudyError(f"factors.{f.name}: case {int(bad[0])} draws {out[f.name][bad[0]]:.6g}; every "
-                                     "value must be > 0 (narrow the distribution)")
-            object.__setattr__(self, "_random", out)
-        return self._random
+                    case = b * DRAW_BLOCK + int(bad[0])
+                    raise StudyError(f"factors.{f.name}: case {case} draws {draws[bad[0]]:.6g}; every value must be "
+                                     "> 0 (narrow the distribution)")
 
     def factor_table(self, case_ids) -> dict:
         """Every factor's value for the cases ``case_ids``: name -> array (file order)."""
@@ -148,7 +171,7 @@ class Study:
         if bad.size:
             raise StudyError(f"case_id must be in [0, {self.n_cases - 1}], got {int(bad[0])}")
         if self.kind == "random":
-            return {name: arr[ids] for name, arr in self._draws().items()}
+            return self._draws(ids)
         sizes = [len(f.values) for f in self.factors]
         out = {}
         rest = ids.copy()
@@ -320,7 +343,7 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
     if study.n_cases > MAX_CASES:
         raise StudyError(f"the design has {study.n_cases} cases; at most {MAX_CASES}")
     if kind == "random":
-        study._draws()              # refuses non-positive draws now, not in a worker
+        study.check_draws()         # refuses non-positive draws now, not in a worker
     return study
 
 
