@@ -901,10 +901,17 @@ def _cmd_study(args, out: _Out) -> int:
         for f in study.factors:
             out.line(f"  {f.describe()}")
         out.stream.flush()
+    import signal
+
+    def _terminated(_signum, _frame):     # a batch system's SIGTERM ends a study as Ctrl-C does
+        raise KeyboardInterrupt
+    previous = signal.signal(signal.SIGTERM, _terminated)
     try:
         summary = run_study(study, out_dir, workers=args.workers, scheduler=args.scheduler)
     except StudyError as exc:
         raise UsageError(str(exc)) from None
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     if args.csv:
         from .study.results import read_study
         tmp = out_dir / ".results.csv.tmp"

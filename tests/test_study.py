@@ -142,7 +142,7 @@ def test_a_rerun_computes_only_the_missing_chunks(tmp_path):
     assert read_study(tmp_path / "out").equals(before)
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL], ids=["SIGINT", "SIGKILL"])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL], ids=["SIGINT", "SIGTERM", "SIGKILL"])
 @pytest.mark.parametrize("workers", [None, 2], ids=["in-process", "2-workers"])
 def test_an_interrupted_study_loses_no_finished_chunk_and_the_rerun_completes_it(tmp_path, sig, workers):
     doc = dict(SMALL, measures=["least_damping_ratio", "critical_speed_kph", "ra_peak"],
@@ -160,7 +160,7 @@ def test_an_interrupted_study_loses_no_finished_chunk_and_the_rerun_completes_it
     assert p.poll() is None, "the study ended before it could be interrupted: make it longer"
     p.send_signal(sig)
     _, err = p.communicate(timeout=60)
-    if sig == signal.SIGINT:
+    if sig in (signal.SIGINT, signal.SIGTERM):           # a batch system's SIGTERM: as Ctrl-C
         assert p.returncode == 130 and err.strip().splitlines()[-1] == "lcv: interrupted", err
         assert "Traceback" not in err
     if workers:                                  # orphaned workers of a killed run may still finish a chunk
