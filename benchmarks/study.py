@@ -234,7 +234,7 @@ def part1(B, n_loop, rounds):
     for _ in range(rounds):
         fb.append(timed(lambda: full_batch(batch))[0] / B)
         fl.append(timed(lambda: full_loop(few))[0] / n_loop)
-    print(f"   the whole measure set (+ single sine, YDC, HSTO, lane-change RA, trim-free):")
+    print("   the whole measure set (+ single sine, YDC, HSTO, lane-change RA, trim-free):")
     print(f"   VariantBatch.measures        {min(fb) * 1e3:7.3f}   loop of measure_set {min(fl) * 1e3:7.3f}   "
           f"ratio {min(fb) / min(fl):5.2f}  (target <= 0.4)")
     return b

@@ -545,7 +545,7 @@ def _cmd_simulate(args, out: _Out) -> int:
     u = _speed_mps(args)
     chunk = 20000                                  # rows per exact run: constant memory
     first = True
-    t_a, state, k = 0.0, None, 0
+    state, k = None, 0
     while k < steps:
         n = min(chunk, steps - k)
         t_b = (k + n) * args.dt

@@ -25,7 +25,7 @@ def main():
     fmu, case, logging = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
     if len(sys.argv) > 4:                              # a different lcvreport imported first
         sys.path.insert(0, sys.argv[4])
-        import lcvreport  # noqa: F401
+        import lcvreport  # noqa: F401  (a stand-in lcvreport in the host, imported first)
         sys.path.remove(sys.argv[4])
     before = {"path": list(sys.path), "meta": [repr(f) for f in sys.meta_path]}
     d = tempfile.mkdtemp()

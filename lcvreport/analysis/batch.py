@@ -263,7 +263,6 @@ class VariantBatch:
         from .field_measures import RA_BAND_HZ
         lo, hi = RA_BAND_HZ
         f = np.linspace(lo, hi, 381)
-        B = self.size
         values = self._ra_scan(speed_mps, f, tire_scale)
         k = np.argmax(values, axis=1)
         where = f[k].astype(float)

@@ -611,7 +611,6 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
     dict
         ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
     """
-    import json
     import os
     import tempfile
     from ..model.vehicle_file import dumps_vehicle
@@ -689,7 +688,6 @@ def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf
     dict
         ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
     """
-    import json
     import os
     import tempfile
     from importlib.metadata import version

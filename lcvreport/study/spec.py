@@ -36,7 +36,6 @@ Examples
 from __future__ import annotations
 
 import hashlib
-import itertools
 import json
 import math
 import tomllib
