@@ -78,6 +78,8 @@ def test_every_row_is_measure_set_of_its_case(tmp_path):
                                                          rel=1e-15)
         assert kwargs == {"tire_scale": row["tire_scale"]}
         doc = measure_set(vehicle, speed_mps, **kwargs).to_dict()
+        trim = doc.get("trim") or {}                    # no source in SMALL: the trim is null
+        doc["trim_delta_rad"], doc["trim_offtracking_m"] = trim.get("delta_rad"), trim.get("offtracking_m")
         for m in SMALL["measures"]:
             # where a smooth maximum lies is known to about sqrt(eps) of its frequency, by the batch's
             # golden section and measure_set's Brent method alike (tests/test_batch.py); values to 1e-12
@@ -334,3 +336,48 @@ def test_a_progress_bar_on_a_terminal_and_none_otherwise(tmp_path):
     assert "cases: 100%" in text and "case/s" in text and "200/200" in text, text
     r = subprocess.run(LCV + ["study", str(path), "--out", str(tmp_path / "pipe")], capture_output=True, text=True)
     assert r.returncode == 0 and r.stderr == "" and "case/s" not in r.stdout
+
+
+def test_load_cases_and_residual_sources_give_measure_sets_trim(tmp_path):
+    """Factors load_units (the 1 % rule on lists of units), P_/T_/eps_<axle> and crossfall_percent
+    act on the trim: each row's trim_delta_rad and trim_offtracking_m equal measure_set's trim of
+    study_case (1e-12), null (NaN) where the case has no source."""
+    doc = {"vehicle": "aucnat", "speed_kph": 88.0, "measures": ["trim_delta_rad", "trim_offtracking_m", "hsso_m"],
+           "design": {"kind": "random", "count": 24, "seed": 8}, "chunk_size": 10,
+           "factors": {"load_units": {"values": [["trailer3"], ["trailer2", "trailer3"], []]},
+                       "P_41_N": {"values": [0.0, 800.0]}, "T_61_Nm": {"values": [0.0, -150.0]},
+                       "eps_21_rad": {"values": [0.0, 0.001]}, "crossfall_percent": {"values": [0.0, 2.0]},
+                       "trailer3.mass_scale": {"distribution": "uniform", "low": 0.6, "high": 1.1}}}
+    run_study(study_from_dict(doc), tmp_path / "out")
+    table = read_study(tmp_path / "out")
+    assert set(table["load_units"]) <= {"trailer3", "trailer2+trailer3", "none"}
+    nulls = 0
+    for _, row in table.iterrows():
+        vehicle, speed_mps, kwargs = study_case(tmp_path / "out", int(row["case_id"]))
+        assert ("load_units" in kwargs) == (row["load_units"] != "none")
+        trim = measure_set(vehicle, speed_mps, **kwargs).to_dict().get("trim")
+        if trim is None:
+            nulls += 1
+            assert np.isnan(row["trim_delta_rad"]) and np.isnan(row["trim_offtracking_m"])
+        else:
+            # sources of both signs can nearly cancel (a steer of 1.7e-9 rad from terms of ~1e-3): 1e-12
+            # relative, or 1e-15 (rad, m) where the trim is ~0 -- 1e-12 of the terms it is the sum of
+            for key in ("delta_rad", "offtracking_m"):
+                got, ref = row[f"trim_{key}"], trim[key]
+                assert abs(got - ref) <= max(1e-12 * abs(ref), 1e-15), (int(row["case_id"]), key, got, ref)
+    assert nulls < len(table)
+
+
+BAD_SOURCES = [
+    ({"P_99_N": {"values": [100.0]}}, "aucnat has no axle '99'"),
+    ({"eps_21_rad": {"values": [0.2]}}, "factors.eps_21_rad.values[0]"),
+    ({"load_units": {"values": [["trailer9"]]}}, "factors.load_units.values[0] must be a list of distinct units"),
+    ({"load_units": {"distribution": "uniform", "low": 0, "high": 1}}, "factors.load_units must be { values"),
+]
+
+
+@pytest.mark.parametrize("factors,fragment", BAD_SOURCES, ids=[f"bad{k}" for k in range(len(BAD_SOURCES))])
+def test_bad_source_factors_are_one_line(factors, fragment):
+    with pytest.raises(StudyError, match=None) as info:
+        study_from_dict({"vehicle": "aucnat", "speed_kph": 88.0, "measures": ["trim_delta_rad"], "factors": factors})
+    assert fragment in str(info.value) and "\n" not in str(info.value), str(info.value)

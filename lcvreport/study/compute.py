@@ -21,7 +21,7 @@ import numpy as np
 
 from ..analysis.batch import VariantBatch
 from ..analysis.measures import RA_FREQUENCY_HZ, measure_set
-from .spec import BATCHED, Study
+from .spec import BATCHED, TRIM, Study
 
 
 def _batched(batch: VariantBatch, speed_mps: float, tire_scale: float, wanted: set) -> dict:
@@ -54,11 +54,16 @@ def compute_chunk(study: Study, case_ids) -> dict:
     scales = np.asarray(table.get("tire_scale", np.ones(ids.size)), dtype=float)
     params = study.batch_parameters(table)
     cols = {"case_id": ids}
-    cols.update({name: np.asarray(arr, dtype=float) for name, arr in table.items()})
+    cols.update({name: (arr if name == "load_units" else np.asarray(arr, dtype=float)) for name, arr in table.items()})
     for m in study.measures:
         cols[m] = np.full(ids.size, np.nan)
     v = study.vehicle
     batched = set(study.measures) & set(BATCHED) if v.steered_axles else set()
+    F = None
+    if batched & set(TRIM):
+        F = np.full((ids.size, v.n_states), np.nan)           # NaN rows: no source (measure_set's null)
+        for k in range(ids.size):
+            F[k] = _case_force(study, int(ids[k]))
     if batched:
         keys = np.stack([speeds, scales], axis=1)
         groups, inverse = np.unique(keys, axis=0, return_inverse=True)
@@ -69,12 +74,37 @@ def compute_chunk(study: Study, case_ids) -> dict:
             for name, arr in _batched(batch, float(u), float(ts), batched).items():
                 if name in batched:
                     cols[name][rows] = np.broadcast_to(arr, rows.shape)
+            if F is not None:
+                has = np.isfinite(F[rows, 0])
+                if has.any():
+                    sub = batch._subset(np.flatnonzero(has)) if batch.size > 1 else batch
+                    delta, off = sub.trim(float(u), F[rows[has]], float(ts))
+                    cols.get("trim_delta_rad", np.empty(ids.size))[rows[has]] = delta
+                    cols.get("trim_offtracking_m", np.empty(ids.size))[rows[has]] = off
     rest = [m for m in study.measures if m not in batched]
     if rest:
         for k, case_id in enumerate(ids):
             vehicle, speed_mps, kwargs = study.case(int(case_id))
             doc = measure_set(vehicle, speed_mps, **kwargs).to_dict()
+            trim = doc.get("trim") or {}
+            doc["trim_delta_rad"], doc["trim_offtracking_m"] = trim.get("delta_rad"), trim.get("offtracking_m")
             for m in rest:
                 value = doc.get(m)
                 cols[m][k] = np.nan if value is None else float(value)
     return cols
+
+
+def _case_force(study: Study, case_id: int) -> np.ndarray:
+    """The generalized force F [SI] of a case's load case and residual sources, as measure_set
+    builds it for the trim (with the case's own masses and tire coefficients); NaN if none."""
+    from ..model.loads import load_vector, one_percent_rule
+    vehicle, _speed, kwargs = study.case(case_id)
+    units, sources = kwargs.get("load_units"), kwargs.get("sources")
+    if not units and not sources:
+        return np.full(vehicle.n_states, np.nan)
+    F = np.zeros(vehicle.n_states)
+    if units:
+        F = F + load_vector(vehicle, one_percent_rule(vehicle, list(units)))
+    if sources:
+        F = F + sources.vector(vehicle, kwargs.get("tire_scale", 1.0))
+    return F

@@ -16,9 +16,12 @@ A study is a TOML file::
     "tractor.cornering_stiffness_scale" = { distribution = "normal", mean = 1.0, sd = 0.05 }
 
 Factors: ``speed_kph`` (km/h; or ``speed_mps``), ``tire_scale`` (measure_set's factor on every
-tire coefficient), and scale factors ``<unit>.mass_scale``, ``<unit>.yaw_inertia_scale`` and
+tire coefficient), scale factors ``<unit>.mass_scale``, ``<unit>.yaw_inertia_scale`` and
 ``<unit or axle>.cornering_stiffness_scale`` / ``.aligning_stiffness_scale`` /
-``.longitudinal_stiffness_scale`` (a unit name scales all its axles).  A factor has ``values``
+``.longitudinal_stiffness_scale`` (a unit name scales all its axles); load cases ``load_units``
+(values: lists of units carrying the 1 % rule, ``[]`` for none); residual sources ``P_<axle>_N``,
+``T_<axle>_Nm``, ``eps_<axle>_rad`` (misalignment) and ``crossfall_percent`` (SPEC section 11;
+they act on the trim measures ``trim_delta_rad`` and ``trim_offtracking_m``).  A factor has ``values``
 (a grid, or in a random design drawn with equal chance), or a ``distribution``: ``uniform``
 (``low``, ``high``) or ``normal`` (``mean``, ``sd``).  Cases are numbered from 0 in design order:
 the grid in the factors' file order (the last factor fastest); random draws per factor and per
@@ -46,22 +49,27 @@ import numpy as np
 
 from ..model.vehicle import Vehicle
 from ..model.vehicle_file import dumps_vehicle, load_vehicle, loads_vehicle
+from ..ranges import RANGES, RangeError
 from ..units import kph_to_mps
 
 #: measures computed batched over the cases (lcvreport.analysis.batch); the others of
 #: ``lcv measures`` are computed case by case with measure_set (same numbers, slower)
 BATCHED = ("least_damping_ratio", "least_damped_frequency_hz", "critical_speed_kph", "ra_frequency",
            "ra_single_sine", "ra_peak", "ra_peak_frequency_hz", "yaw_damping_coefficient", "hsto_m",
-           "ra_lane_change", "hsso_m", "steady_turn_delta_rad")
+           "ra_lane_change", "hsso_m", "steady_turn_delta_rad", "trim_delta_rad", "trim_offtracking_m")
 #: every measure a study can ask for: the scalar keys of ``lcv measures --json``
 MEASURES = BATCHED + ("lssp_m",
                       "low_speed_offtracking_m", "max_tail_swing_m", "frontal_swing_m")
-DEFAULT_MEASURES = BATCHED
+DEFAULT_MEASURES = BATCHED[:-2]
+#: the trim's measures (``trim.delta_rad``, ``trim.offtracking_m`` of ``lcv measures``): need a source
+TRIM = ("trim_delta_rad", "trim_offtracking_m")
 UNIT_SCALES = {"mass_scale": "mass_kg", "yaw_inertia_scale": "yaw_inertia_kg_m2"}
 AXLE_SCALES = {"cornering_stiffness_scale": "cornering_stiffness_N_per_rad",
                "aligning_stiffness_scale": "aligning_stiffness_Nm_per_rad",
                "longitudinal_stiffness_scale": "longitudinal_stiffness_N"}
-PLAIN_FACTORS = ("speed_kph", "speed_mps", "tire_scale")
+PLAIN_FACTORS = ("speed_kph", "speed_mps", "tire_scale", "crossfall_percent", "load_units")
+#: residual-source factors: name prefix and suffix -> (ranges key, what)
+RESIDUALS = {("P_", "_N"): "residual_force", ("T_", "_Nm"): "residual_moment", ("eps_", "_rad"): "misalignment"}
 MAX_CASES = 10_000_000
 #: cases per block of random draws (each block, each factor its own generator)
 DRAW_BLOCK = 4096
@@ -84,6 +92,8 @@ class Factor:
     sd: float = math.nan
 
     def describe(self) -> str:
+        if self.values and self.name == "load_units":
+            return f"{self.name}: values {', '.join(load_label(u) for u in self.values)}"
         if self.values:
             return f"{self.name}: values {list(self.values)}"
         if self.distribution == "uniform":
@@ -132,7 +142,7 @@ class Study:
         n = min(DRAW_BLOCK, self.count - block * DRAW_BLOCK)
         rng = np.random.default_rng([self.seed, factor_index, block])
         if f.values:
-            return np.asarray(f.values, dtype=float)[rng.integers(0, len(f.values), n)]
+            return _value_array(f)[rng.integers(0, len(f.values), n)]
         if f.distribution == "uniform":
             return rng.uniform(f.low, f.high, n)
         return rng.normal(f.mean, f.sd, n)
@@ -142,7 +152,7 @@ class Study:
         out = {}
         blocks = np.unique(ids // DRAW_BLOCK)
         for i, f in enumerate(self.factors):
-            values = np.empty(ids.size)
+            values = np.empty(ids.size, dtype=object if f.name == "load_units" else float)
             for b in blocks:
                 sel = ids // DRAW_BLOCK == b
                 values[sel] = self._block(i, int(b))[ids[sel] - b * DRAW_BLOCK]
@@ -155,13 +165,16 @@ class Study:
         for i, f in enumerate(self.factors):
             if f.distribution != "normal":
                 continue
+            key = residual_key(f.name)
+            lo, hi = (RANGES[key].low, RANGES[key].high) if key else (0.0, math.inf)
             for b in range(math.ceil(self.count / DRAW_BLOCK)):
                 draws = self._block(i, b)
-                bad = np.flatnonzero(~(draws > 0))
+                bad = np.flatnonzero(~((draws > lo) if not key else ((draws >= lo) & (draws <= hi))))
                 if bad.size:
                     case = b * DRAW_BLOCK + int(bad[0])
+                    valid = f"in [{lo:g}, {hi:g}]" if key else "> 0"
                     raise StudyError(f"factors.{f.name}: case {case} draws {draws[bad[0]]:.6g}; every value must be "
-                                     "> 0 (narrow the distribution)")
+                                     f"{valid} (narrow the distribution)")
 
     def factor_table(self, case_ids) -> dict:
         """Every factor's value for the cases ``case_ids``: name -> array (file order)."""
@@ -175,7 +188,7 @@ class Study:
         out = {}
         rest = ids.copy()
         for f, n in zip(reversed(self.factors), reversed(sizes)):
-            out[f.name] = np.asarray(f.values, dtype=float)[rest % n]
+            out[f.name] = _value_array(f)[rest % n]
             rest //= n
         return {f.name: out[f.name] for f in self.factors}
 
@@ -193,7 +206,7 @@ class Study:
         v = self.vehicle
         out = {}
         for name, arr in table.items():
-            if name in PLAIN_FACTORS:
+            if name in PLAIN_FACTORS or residual_key(name):
                 continue
             owner, key = name.split(".", 1)
             unit = next((u for u in v.units if u.name == owner), None)
@@ -224,7 +237,27 @@ class Study:
                         axles[j] = replace(axles[j], **{key: float(arr[0])})
                         units[i] = replace(units[i], axles=tuple(axles))
         kwargs = {"tire_scale": float(table["tire_scale"][0])} if "tire_scale" in table else {}
+        if "load_units" in table and table["load_units"][0] != "none":
+            kwargs["load_units"] = table["load_units"][0].split("+")
+        sources = self.sources({k: a[:1] for k, a in table.items()}, 0)
+        if sources:
+            kwargs["sources"] = sources
         return replace(v, units=tuple(units)), float(self.speeds_mps(table)[0]), kwargs
+
+    def sources(self, table: dict, k: int):
+        """The residual sources (SPEC section 11) of row ``k`` of ``table``: a
+        :class:`~lcvreport.model.loads.ResidualSources` (empty when the study has none)."""
+        from ..model.loads import ResidualLoads, ResidualSources
+        P, T, eps, cross = {}, {}, {}, 0.0
+        for name, arr in table.items():
+            key = residual_key(name)
+            if key == "crossfall":
+                cross = float(arr[k])
+            elif key:
+                {"residual_force": P, "residual_moment": T, "misalignment": eps}[key][residual_axle(name)] = \
+                    float(arr[k])
+        return ResidualSources(ResidualLoads({a: x for a, x in P.items() if x}, {a: x for a, x in T.items() if x}),
+                               {a: x for a, x in eps.items() if x}, cross)
 
     # ------------------------------------------------------------------ identity
     def to_dict(self) -> dict:
@@ -238,6 +271,13 @@ class Study:
         return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()
 
 
+def _value_array(f: Factor) -> np.ndarray:
+    """A factor's values as an array to index: numbers, or the load cases' labels."""
+    if f.name == "load_units":
+        return np.array([load_label(u) for u in f.values], dtype=object)
+    return np.asarray(f.values, dtype=float)
+
+
 def _number(where: str, value, positive: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or \
             (positive and value <= 0):
@@ -245,36 +285,88 @@ def _number(where: str, value, positive: bool = False) -> float:
     return float(value)
 
 
+def residual_key(name: str) -> str | None:
+    """The ranges key of a residual-source factor (``P_<axle>_N`` ... ``crossfall_percent``), else None."""
+    if name == "crossfall_percent":
+        return "crossfall"
+    for (pre, post), key in RESIDUALS.items():
+        if name.startswith(pre) and name.endswith(post) and len(name) > len(pre) + len(post):
+            return key
+    return None
+
+
+def residual_axle(name: str) -> str:
+    """The axle of ``P_<axle>_N``, ``T_<axle>_Nm``, ``eps_<axle>_rad``."""
+    for pre, post in RESIDUALS:
+        if name.startswith(pre) and name.endswith(post):
+            return name[len(pre):-len(post)]
+    raise KeyError(name)
+
+
+def load_label(units) -> str:
+    """The table's text of a load case: ``trailer2+trailer3``, ``none``."""
+    return "+".join(units) or "none"
+
+
+def _load_units_factor(vehicle: Vehicle, where: str, spec) -> Factor:
+    vals = spec.get("values") if isinstance(spec, dict) else None
+    if set(spec if isinstance(spec, dict) else {}) - {"values"} or not isinstance(vals, list) or not vals:
+        raise StudyError(f"{where} must be {{ values = [[\"unit\", ...], ...] }}: lists of the units carrying the 1 % "
+                         f"rule ([] for none), got {spec!r}")
+    out = []
+    for k, units in enumerate(vals):
+        if not isinstance(units, list) or any(u not in vehicle.unit_names for u in units) or \
+                len(set(units)) != len(units):
+            raise StudyError(f"{where}.values[{k}] must be a list of distinct units of {vehicle.name} "
+                             f"({', '.join(vehicle.unit_names)}), got {units!r}")
+        out.append(tuple(units))
+    return Factor("load_units", tuple(out))
+
+
 def _factor(vehicle: Vehicle, name: str, spec) -> Factor:
     where = f"factors.{name}"
-    if name not in PLAIN_FACTORS:
+    if name == "load_units":
+        return _load_units_factor(vehicle, where, spec)
+    signed = residual_key(name)
+    if signed and name != "crossfall_percent" and residual_axle(name) not in {a.name for a in vehicle.axles}:
+        raise StudyError(f"{where}: {vehicle.name} has no axle {residual_axle(name)!r}; axles: "
+                         f"{', '.join(a.name for a in vehicle.axles)}")
+    if name not in PLAIN_FACTORS and not signed:
         owner, _, key = name.partition(".")
         units = {u.name for u in vehicle.units}
         axles = {a.name for a in vehicle.axles}
         if key in UNIT_SCALES and owner not in units or key in AXLE_SCALES and owner not in units | axles or \
                 key not in UNIT_SCALES and key not in AXLE_SCALES:
-            raise StudyError(f"{where}: unknown factor; valid: {', '.join(PLAIN_FACTORS)}, <unit>."
-                             f"{{{','.join(UNIT_SCALES)}}} (units: {', '.join(sorted(units))}), <unit or axle>."
-                             f"{{{','.join(AXLE_SCALES)}}} (axles: {', '.join(sorted(axles))})")
+            raise StudyError(f"{where}: unknown factor; valid: {', '.join(PLAIN_FACTORS)}, P_<axle>_N, "
+                             f"T_<axle>_Nm, eps_<axle>_rad, <unit>.{{{','.join(UNIT_SCALES)}}} (units: "
+                             f"{', '.join(sorted(units))}), <unit or axle>.{{{','.join(AXLE_SCALES)}}} (axles: "
+                             f"{', '.join(sorted(axles))})")
     if not isinstance(spec, dict):
         raise StudyError(f"{where} must be a table with values = [...] or distribution = ..., got {spec!r}")
     unknown = set(spec) - {"values", "distribution", "low", "high", "mean", "sd"}
     if unknown:
         raise StudyError(f"{where}: unknown key {sorted(unknown)[0]!r}; valid: values, distribution, low, high, "
                          "mean, sd")
+    positive = not signed                      # scales and speeds > 0; residual sources any sign, in range
+
+    def number(key, value):
+        x = _number(f"{where}.{key}", value, positive)
+        if signed:
+            RANGES[signed].check(x, f"{where}.{key}")
+        return x
     if "values" in spec:
         vals = spec["values"]
         if not isinstance(vals, list) or not vals:
             raise StudyError(f"{where}.values must be a non-empty list of numbers, got {vals!r}")
-        return Factor(name, tuple(_number(f"{where}.values[{k}]", x, positive=True) for k, x in enumerate(vals)))
+        return Factor(name, tuple(number(f"values[{k}]", x) for k, x in enumerate(vals)))
     dist = spec.get("distribution")
     if dist == "uniform":
-        lo, hi = _number(f"{where}.low", spec.get("low"), True), _number(f"{where}.high", spec.get("high"), True)
+        lo, hi = number("low", spec.get("low")), number("high", spec.get("high"))
         if not lo < hi:
             raise StudyError(f"{where}: low must be below high, got low {lo:g}, high {hi:g}")
         return Factor(name, distribution="uniform", low=lo, high=hi)
     if dist == "normal":
-        mean, sd = _number(f"{where}.mean", spec.get("mean"), True), _number(f"{where}.sd", spec.get("sd"), True)
+        mean, sd = number("mean", spec.get("mean")), _number(f"{where}.sd", spec.get("sd"), True)
         return Factor(name, distribution="normal", mean=mean, sd=sd)
     raise StudyError(f"{where}.distribution must be uniform or normal (or give values = [...]), got {dist!r}")
 
@@ -314,7 +406,10 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
     if not isinstance(factors_doc, dict) or not factors_doc:
         raise StudyError("factors: at least one factor is needed (a table of factor = {values = [...]} or "
                          "{distribution = ...})")
-    factors = tuple(_factor(vehicle, n, s) for n, s in factors_doc.items())
+    try:
+        factors = tuple(_factor(vehicle, n, s) for n, s in factors_doc.items())
+    except RangeError as exc:
+        raise StudyError(str(exc.args[0] if exc.args else exc)) from None
     if "speed_kph" in factors_doc and "speed_mps" in factors_doc:
         raise StudyError("factors: give speed_kph or speed_mps, not both")
     speed_kph = None
@@ -362,6 +457,7 @@ def load_study(path) -> Study:
 
 def study_from_stored(doc: dict) -> Study:
     """The study of :meth:`Study.to_dict` (as stored with the results)."""
-    factors = tuple(Factor(**(f | {"values": tuple(f["values"])})) for f in doc["factors"])
+    factors = tuple(Factor(**(f | {"values": tuple(tuple(x) if isinstance(x, list) else x for x in f["values"])}))
+                    for f in doc["factors"])
     return Study(loads_vehicle(doc["vehicle_toml"]), factors, doc["kind"], tuple(doc["measures"]), doc["count"],
                  doc["seed"], doc["speed_kph"], doc["chunk_size"])
