@@ -144,6 +144,20 @@ def _initial_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
     return []
 
 
+def enumeration_items(parent: Element, v: FmuVariable) -> None:
+    """``<Item name=.. value=k>`` of every item of the Enumeration ``v`` (FMI 2.0 and 3.0 alike)."""
+    for k, item in enumerate(v.items, 1):
+        SubElement(parent, "Item", name=item, value=str(k))
+
+
+def categories_and_experiment(root: Element) -> None:
+    """``<LogCategories>`` and ``<DefaultExperiment>`` (the same elements in FMI 2.0 and 3.0)."""
+    cats = SubElement(root, "LogCategories")
+    for name, text in LOG_CATEGORIES.items():
+        SubElement(cats, "Category", name=name, description=text)
+    SubElement(root, "DefaultExperiment", DEFAULT_EXPERIMENT)
+
+
 def enumeration_type_name(v: FmuVariable) -> str:
     """The declared type of an Enumeration variable: ``preset`` -> ``Preset``."""
     return v.name[:1].upper() + v.name[1:]
@@ -218,14 +232,9 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
     declared = {key: name for key, (name, _attrs) in declared.items()}
     for v in itf.variables:     # the Enumeration of the presets (SPEC section 15)
         if v.type == "Enumeration":
-            enum = SubElement(SubElement(types, "SimpleType", name=enumeration_type_name(v),
-                                         description=f"Values of {v.name}"), "Enumeration")
-            for k, item in enumerate(v.items, 1):
-                SubElement(enum, "Item", name=item, value=str(k))
-    cats = SubElement(root, "LogCategories")
-    for name, text in LOG_CATEGORIES.items():
-        SubElement(cats, "Category", name=name, description=text)
-    SubElement(root, "DefaultExperiment", DEFAULT_EXPERIMENT)
+            enumeration_items(SubElement(SubElement(types, "SimpleType", name=enumeration_type_name(v),
+                                                    description=f"Values of {v.name}"), "Enumeration"), v)
+    categories_and_experiment(root)
     mv = SubElement(root, "ModelVariables")
     for v in itf.variables:
         sv = SubElement(mv, "ScalarVariable", variable_attributes(v))

@@ -18,7 +18,7 @@ from __future__ import annotations
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from .interface import Interface
-from .model_description import (DEFAULT_EXPERIMENT, LOG_CATEGORIES, UNIT_DERIVATIVE, _direct_dependencies,
+from .model_description import (UNIT_DERIVATIVE, _direct_dependencies, categories_and_experiment, enumeration_items,
                                 _initial_dependencies, _num, _state_dependencies, declared_types,
                                 enumeration_type_name, enumeration_value, guid,
                                 unit_definitions, variable_attributes)
@@ -63,14 +63,9 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
         declared[key] = name
     for v in itf.variables:
         if v.type == "Enumeration":
-            enum = SubElement(types, "EnumerationType", name=enumeration_type_name(v),
-                              description=f"Values of {v.name}")
-            for k, item in enumerate(v.items, 1):
-                SubElement(enum, "Item", name=item, value=str(k))
-    cats = SubElement(root, "LogCategories")
-    for name, text in LOG_CATEGORIES.items():
-        SubElement(cats, "Category", name=name, description=text)
-    SubElement(root, "DefaultExperiment", DEFAULT_EXPERIMENT)
+            enumeration_items(SubElement(types, "EnumerationType", name=enumeration_type_name(v),
+                                         description=f"Values of {v.name}"), v)
+    categories_and_experiment(root)
     mv = SubElement(root, "ModelVariables")
     t_vr = time_value_reference(itf)
     SubElement(mv, "Float64", {"name": "time", "valueReference": str(t_vr), "causality": "independent",
