@@ -116,6 +116,23 @@ def test_ra_peak_equals_a_brute_force_grid(name):
     assert abs(p.frequency_hz - f[k]) <= 1e-5
 
 
+@pytest.mark.parametrize("name", ["tractor_semitrailer", "aucnat", "empty"])
+@pytest.mark.parametrize("kph", [60.0, 100.0])
+def test_ra_peak_frequency_is_the_vertex_of_an_independent_parabola(name, kph):
+    # RA at f and f +- h through steer_to_acceleration (stacked solves, not ra_peak's own
+    # factorisation); the parabola's vertex locates the maximum to ~1e-10 Hz (bias from the
+    # third derivative ~h^2, rounding ~eps/h); a search on RA's values alone stops ~1e-8 away
+    v = load_preset(name)
+    u = kph / 3.6
+    p = fm.ra_peak(v, u)
+    h = 1e-5
+    G = np.abs(steer_to_acceleration(v, u, p.frequency_hz + np.array([-h, 0.0, h])))
+    r = G[:, -1] / G[:, 0]
+    vertex = p.frequency_hz + h * (r[0] - r[2]) / (2 * (r[0] - 2 * r[1] + r[2]))
+    assert abs(vertex - p.frequency_hz) <= 1e-9
+    assert p.value == pytest.approx(r[1], rel=1e-13)
+
+
 def test_the_ratio_method_of_one_damped_mode_is_its_modal_damping_ratio():
     for lam in (-0.3 + 2.0j, -1.2 + 7.5j, -0.05 + 0.9j):
         t = (np.arange(9) * np.pi - np.angle(lam)) / lam.imag        # extrema of exp(sigma t) sin(omega t)

@@ -153,21 +153,37 @@ class ManoeuvreResponse:
             c = seg.C[js].T                                   # (dim, K)
             c1 = seg.Mz.T @ c
             c2 = seg.Mz.T @ c1
-            Y = seg.Z @ np.concatenate([c, c1, c2], axis=1)   # one product for all: (samples, 3K)
             dt = t[1] - t[0] if t.size > 1 else 0.0
-            for s in range(K):
-                y, d1, d2 = Y[:, s], Y[:, K + s], Y[:, 2 * K + s]
-                # a sign change of the derivative, or a zero of it at a sample (not a flat stretch)
-                change = np.flatnonzero(((d1[:-1] > 0) != (d1[1:] > 0)) & ((d1[:-1] != 0) | (d1[1:] != 0)))
-                change = change[(t[change + 1] >= t_from) & (t[change] <= t_to)]
-                if change.size:
-                    k, k1 = change, change + 1
-                    tau = _hermite_roots(d1[k], d2[k], d1[k1], d2[k1], dt)
+            if t.size > 1:
+                D1 = c1.T @ seg.Z.T                           # the derivatives at the samples: (K, samples)
+                pos = D1 > 0
+                # a sign change of the derivative, or a zero of it at a sample (not a flat stretch),
+                # in an interval that reaches into the window
+                change = pos[:, :-1] != pos[:, 1:]
+                nonzero = D1 != 0
+                if not nonzero.all():
+                    change &= nonzero[:, :-1] | nonzero[:, 1:]
+                if t[0] < t_from or t[-1] > t_to:
+                    change &= (t[1:] >= t_from) & (t[:-1] <= t_to)
+                sig, k = np.nonzero(change)                   # by signal, then by time
+                if k.size:
+                    k1 = k + 1
+                    W = np.concatenate([c, c2], axis=1)       # values and second derivatives, at the ends only
+                    Ya, Yb = seg.Z[k] @ W, seg.Z[k1] @ W
+                    rows = np.arange(k.size)
+                    ya, sa, yb, sb = Ya[rows, sig], Ya[rows, K + sig], Yb[rows, sig], Yb[rows, K + sig]
+                    da, db = D1[sig, k], D1[sig, k1]
+                    tau = _hermite_roots(da, sa, db, sb, dt)
                     tk = t[k] + tau * dt
-                    val = _quintic(y[k], d1[k], d2[k], y[k1], d1[k1], d2[k1], dt, tau)
+                    val = _quintic(ya, da, sa, yb, db, sb, dt, tau)
                     keep = (tk >= t_from) & (tk <= t_to)
-                    times[s].extend(tk[keep].tolist())
-                    values[s].extend(val[keep].tolist())
+                    sig, tk, val = sig[keep], tk[keep], val[keep]
+                    bounds = np.searchsorted(sig, np.arange(K + 1))
+                    for s_ in range(K):
+                        lo, hi = bounds[s_], bounds[s_ + 1]
+                        if hi > lo:
+                            times[s_].extend(tk[lo:hi].tolist())
+                            values[s_].extend(val[lo:hi].tolist())
             # the piece's own ends
             for tb, zb in ((seg.t0, seg.z_start), (seg.t1, seg.z_end)):
                 if zb is not None and t_from <= tb <= t_to and math.isfinite(tb):
@@ -232,7 +248,7 @@ def _hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
     sign, slopes d0, d1 per unit time over a step h), vectorized: Newton from the secant
     root, kept inside a bracket that shrinks with every iterate (safeguarded)."""
     f0, d0, f1, d1 = (np.asarray(a, dtype=float) for a in (f0, d0, f1, d1))
-    if f0.ndim == 1 and f0.size <= 64:     # the usual few roots: the same iteration on floats, no array overhead
+    if f0.ndim == 1 and f0.size <= 16:     # the usual few roots: the same iteration on floats, no array overhead
         return np.array([_hermite_root(*args, float(h)) for args in zip(f0.tolist(), d0.tolist(), f1.tolist(),
                                                                  d1.tolist())])
     d0, d1 = d0 * h, d1 * h

@@ -167,23 +167,34 @@ class SingleSine:
     time : numpy.ndarray, shape (K,)
         Sample times from the start of the steer [s].
     delta : numpy.ndarray, shape (K,)
-        Steer angle (the continuous sine) at the samples [rad].
+        Steer angle (the continuous sine) at the samples [rad] (computed on access).
     ay : numpy.ndarray, shape (K, N)
-        Lateral acceleration of every unit's CG at the samples [m/s^2].
+        Lateral acceleration of every unit's CG at the samples [m/s^2] (computed on access).
     frequency_hz, delta0_rad, speed_mps : float
     vehicle : Vehicle
     peaks : numpy.ndarray, shape (N,)
         max|a_i| per unit on the continuous response [m/s^2] (between the samples).
+    response : lcvreport.analysis.exact.ManoeuvreResponse
+        The exact response the samples come from.
     """
 
     time: np.ndarray
-    delta: np.ndarray
-    ay: np.ndarray
     frequency_hz: float
     delta0_rad: float
     speed_mps: float
     vehicle: Vehicle = field(repr=False, default=None)
     peaks: np.ndarray = None
+    response: object = field(repr=False, default=None)
+
+    @property
+    def delta(self) -> np.ndarray:
+        """Steer angle at the samples [rad]."""
+        return self.response["delta"]
+
+    @property
+    def ay(self) -> np.ndarray:
+        """Lateral acceleration of every unit's CG at the samples, shape (K, N) [m/s^2]."""
+        return np.column_stack([self.response[f"ay{i + 1}"] for i in range(self.vehicle.n_units)])
 
     @property
     def rearward_amplification(self) -> float:
@@ -217,10 +228,8 @@ def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_H
     steer = sine(delta0_rad, f)
     t_end = round((1.0 / f + tail_s) / step_s) * step_s
     r = response(vehicle, speed_mps, steer, t_end, step_s, tire_scale=tire_scale)
-    names = [f"ay{i + 1}" for i in range(vehicle.n_units)]
-    ay = np.column_stack([r[n] for n in names])
-    peaks = r.peaks_abs(names)
-    return SingleSine(r.time, r["delta"], ay, f, float(delta0_rad), float(speed_mps), vehicle, peaks)
+    peaks = r.peaks_abs([f"ay{i + 1}" for i in range(vehicle.n_units)])
+    return SingleSine(r.time, f, float(delta0_rad), float(speed_mps), vehicle, peaks, r)
 
 
 @dataclass(frozen=True)
@@ -536,7 +545,9 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
                           critical_speed(vehicle, tire_scale), None, None, None, None, units, float(f_hz), undefined,
                           sources=sources, **low)
     gains = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
-    ss = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale)
+    # only the numbers are kept: each manoeuvre's response (up to a megabyte of samples) is freed
+    # before the next one is computed (a smaller heap, which malloc does not hand back and fault in)
+    ra_ss = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale).rearward_amplification
     tr = None
     if has_sources:
         F = np.zeros(vehicle.n_states)
@@ -548,20 +559,23 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
         check_trim(tr)
     undefined = {k: low_why for k in LOW_SPEED_KEYS if low_why}
     peak = fm.ra_peak(vehicle, speed_mps, tire_scale)
-    ydc = fm.yaw_damping_coefficient(vehicle, speed_mps, tire_scale)
-    if ydc.value is None:
+    ydc = fm._yaw_damping(vehicle, speed_mps, tire_scale, zeta)
+    ydc_value = ydc.value
+    if ydc_value is None:
         undefined["yaw_damping_coefficient"] = f"undefined: {ydc.why}"
+    del ydc
     try:
         lc = fm.lane_change_measures(vehicle, speed_mps, tire_scale)
         hsto, ra_lc = lc.hsto_m, lc.ra_lane_change
+        del lc
     except ManoeuvreError as exc:
         hsto = ra_lc = None
         undefined["hsto_m"] = undefined["ra_lane_change"] = f"undefined: {exc}"
     turn = fm.steady_turn(vehicle, speed_mps, tire_scale)
     return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
-                      critical_speed(vehicle, tire_scale), float(gains[-1] / gains[0]), ss.rearward_amplification,
+                      critical_speed(vehicle, tire_scale), float(gains[-1] / gains[0]), ra_ss,
                       [float(g) for g in gains], tr, units, float(f_hz), undefined, peak.value, peak.frequency_hz,
-                      ydc.value, hsto, ra_lc, turn.hsso_m, turn.delta_rad, sources, **low)
+                      ydc_value, hsto, ra_lc, turn.hsso_m, turn.delta_rad, sources, **low)
 
 
 def check_trim(tr: Trim) -> None:

@@ -136,10 +136,27 @@ class SystemCoefficients:
         return R
 
     def state_derivative_maps(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-        """(A, G) with ``x' = A x + G F``: ``A = M^-1 S``, ``G = M^-1`` (equilibrated solve)."""
+        """(A, G) with ``x' = A x + G F``: ``A = M^-1 S``, ``G = M^-1`` (equilibrated solve).
+
+        For one speed and tire scale the result is kept (the last :data:`MAPS_KEPT` pairs,
+        read-only arrays): a measure set asks for the same maps some twenty times."""
+        scalar = np.ndim(speed_mps) == 0 and np.ndim(tire_scale) == 0
+        if scalar:
+            key = (float(speed_mps), float(tire_scale))
+            memo = self.__dict__.setdefault("_maps_memo", {})
+            hit = memo.get(key)
+            if hit is not None:
+                return hit
         n = self.n_states
         AG = solve_scaled(self.M(speed_mps), np.hstack([self.S(speed_mps, tire_scale), np.eye(n)]))
-        return AG[:, :n], AG[:, n:]
+        A, G = AG[:, :n], AG[:, n:]
+        if scalar:
+            A.setflags(write=False)
+            G.setflags(write=False)
+            if len(memo) >= MAPS_KEPT:
+                memo.pop(next(iter(memo)))
+            memo[key] = (A, G)
+        return A, G
 
     def acceleration_maps(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(Ca, Da) with the lateral accelerations of the unit CGs ``a = Ca x + Da F``
@@ -183,6 +200,10 @@ def kinematic_jacobians(rear: np.ndarray, front: np.ndarray) -> tuple[np.ndarray
             K[i, j] = 1.0
         Jv[i, 1 + i] -= front[i]
     return Jv, Jr, K
+
+
+#: (A, G) pairs kept per vehicle by :meth:`SystemCoefficients.state_derivative_maps`
+MAPS_KEPT = 8
 
 
 @lru_cache(maxsize=256)

@@ -276,6 +276,20 @@ class Vehicle:
     description: str = ""
     source: str = field(default="", compare=False, hash=False)
 
+    def __hash__(self) -> int:
+        # the caches keyed by vehicle (system_coefficients) hash it on every call: a 6-unit
+        # vehicle's fields hash in ~9 us, so the hash is kept (the vehicle is immutable)
+        h = self.__dict__.get("_hash")
+        if h is None:
+            h = hash((self.name, self.units, self.description))
+            object.__setattr__(self, "_hash", h)
+        return h
+
+    def __getstate__(self):
+        # str hashes differ between processes (hash randomisation): a pickled vehicle
+        # recomputes its hash where it is loaded
+        return {k: v for k, v in self.__dict__.items() if k != "_hash"}
+
     def __post_init__(self):
         _name("name", self.name, VEHICLE_NAME, "a name that starts with a letter (letters, digits, _)")
         units = tuple(self.units) if isinstance(self.units, (list, tuple)) else self.units

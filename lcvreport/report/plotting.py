@@ -548,9 +548,10 @@ def plot_single_sine(ss, ax=None) -> Figure:
         fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
     else:
         fig = ax.figure
-    names = ss.vehicle.unit_names if ss.vehicle is not None else [f"unit {i + 1}" for i in range(ss.ay.shape[1])]
-    for i in range(ss.ay.shape[1]):
-        ax.plot(ss.time, ss.ay[:, i], color=PALETTE[i % len(PALETTE)], lw=1.0,
+    ay = ss.ay
+    names = ss.vehicle.unit_names if ss.vehicle is not None else [f"unit {i + 1}" for i in range(ay.shape[1])]
+    for i in range(ay.shape[1]):
+        ax.plot(ss.time, ay[:, i], color=PALETTE[i % len(PALETTE)], lw=1.0,
                 label=f"a{i + 1} {names[i]} (peak {ss.peaks[i]:.3g})")
     ax2 = ax.twinx()
     ax2.plot(ss.time, np.degrees(ss.delta), color="black", lw=0.8, ls=":", label="steer angle")
