@@ -41,6 +41,9 @@ UNIT_PARAMETERS = ("mass_kg", "yaw_inertia_kg_m2")
 AXLE_PARAMETERS = ("cornering_stiffness_N_per_rad", "aligning_stiffness_Nm_per_rad", "longitudinal_stiffness_N")
 
 
+#: variants whose time responses are computed together (their samples stay in cache)
+RESPONSE_GROUP = 8
+
 #: eigenvector condition number above which the RA scan of a variant uses exact solves
 SCAN_COND_MAX = 1e8
 
@@ -78,6 +81,55 @@ def _nominal(vehicle: Vehicle, name: str) -> float:
                 return float(getattr(a, key))
     _with(vehicle, name, 0.0)                     # raises with the valid names
     raise AssertionError  # pragma: no cover
+
+
+def ratio_damping_groups(group: np.ndarray, signal: np.ndarray, values: np.ndarray):
+    """:func:`lcvreport.analysis.field_measures.ratio_damping` of many signals at once: ``values``
+    holds each signal's extrema in time order, the signals one after the other, labelled by
+    ``(group, signal)``.  Returns (zeta, group, signal) of every signal with two kept amplitudes
+    or more (the same arithmetic in the same order: equal to the one-signal function to a few ulp,
+    numpy's vectorised logarithm and its scalar one differing by an ulp at most).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = np.exp(-0.3 * np.pi / 2 * np.arange(8)) * (-1.0) ** np.arange(8)
+    >>> z, g, s = ratio_damping_groups(np.zeros(8, int), np.zeros(8, int), A)
+    >>> from lcvreport.analysis.field_measures import ratio_damping
+    >>> bool(abs(z[0] - ratio_damping(A)[0]) <= 1e-15)
+    True
+    """
+    from .field_measures import YDC_MAX_AMPLITUDES, YDC_MIN_FRACTION
+    group, signal, values = np.asarray(group), np.asarray(signal), np.asarray(values, dtype=float)
+    empty = (np.zeros(0), np.zeros(0, int), np.zeros(0, int))
+    if values.size < 3:
+        return empty
+    new = np.r_[True, (group[1:] != group[:-1]) | (signal[1:] != signal[:-1])]
+    label = np.cumsum(new) - 1                                  # one label per signal
+    same = label[1:] == label[:-1]
+    P = np.abs(np.diff(values))[same]                           # peak-to-peak amplitudes
+    lab = label[1:][same]
+    if not P.size:
+        return empty
+    starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
+    pmax = np.maximum.reduceat(P, starts)
+    which = np.cumsum(np.r_[True, lab[1:] != lab[:-1]]) - 1   # index into starts
+    keep = P >= YDC_MIN_FRACTION * pmax[which]
+    rank = np.cumsum(keep)
+    before = np.r_[0, rank][starts][which]                      # kept amplitudes before the signal's first
+    keep &= (rank - before) <= YDC_MAX_AMPLITUDES
+    P, lab = P[keep], lab[keep]
+    pair = lab[1:] == lab[:-1]
+    d = np.log(P[:-1][pair] / P[1:][pair])
+    z = d / np.sqrt(np.pi ** 2 + d ** 2)
+    zl = lab[:-1][pair]
+    if not zl.size:
+        return empty
+    firsts = np.flatnonzero(np.r_[True, zl[1:] != zl[:-1]])
+    counts = np.diff(np.r_[firsts, zl.size])
+    sums = np.add.reduceat(z, firsts)
+    idx = np.flatnonzero(new)[zl[firsts]]                        # each signal's first element
+    return sums / counts, group[idx], signal[idx]
 
 
 @dataclass
@@ -254,12 +306,38 @@ class VariantBatch:
         (groups of 256 variants)."""
         return self._in_groups("_ra_peak", speed_mps, tire_scale)
 
+    def _ra_slope(self, speed_mps: float, x_hz: np.ndarray, tire_scale: float, rows: np.ndarray) -> np.ndarray:
+        """d ln RA / d omega of variant rows[k] at x_hz[k] [Hz] (its sign is that of dRA/df), exact:
+        ``dz/dw = -(jwM - S)^-1 jM z``, as the one-variant ``ra_peak``."""
+        co = system_coefficients(self.vehicle)
+        c = {k: v[rows] for k, v in self.coefficients.items()}
+        u = float(speed_mps)
+        M = c["M0"] + u * c["M1"]
+        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        w = 2 * np.pi * np.asarray(x_hz, dtype=float)
+        A = 1j * w[:, None, None] * M - S
+        z = np.linalg.solve(A, (tire_scale * c["Bdelta"])[..., None].astype(complex))
+        dz = np.linalg.solve(A, -1j * (M @ z))
+        # products per variant (stacks of 1-row matrices): a variant's numbers do not depend on
+        # how many others share the call (a (K, n) @ (n, 2) product may round by K)
+        z, dz = np.swapaxes(z, 1, 2), np.swapaxes(dz, 1, 2)                   # (K, 1, n)
+        ends = np.array([0, self.vehicle.n_units - 1])
+        V, R = co.velocity_map(u)[ends].T, co.yaw_rate_map()[ends].T
+        jw = (1j * w)[:, None, None]
+        zV = z @ V
+        G = (zV * jw + u * (z @ R))[:, 0]
+        dG = (dz @ V * jw + 1j * zV + u * (dz @ R))[:, 0]
+        g = (G.conj() * dG).real / (G.conj() * G).real
+        return g[:, 1] - g[:, 0]
+
     def _ra_peak(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(max RA(f) over 0.1-2 Hz [-], where [Hz]) of every variant: the 0.005 Hz scan of
         :func:`lcvreport.analysis.field_measures.ra_peak` (on the variants' modes, :meth:`_ra_scan`),
-        then a golden-section search of each variant's best bracket to 1e-12 Hz on exact solves
-        (the one-variant version uses Brent's method).  Each variant's search stops on its own, so
-        its result does not depend on the other variants of the batch."""
+        then the zero of the exact slope d ln RA / d omega in each variant's best bracket (the
+        Illinois variant of regula falsi, to 1e-13 Hz; the one-variant version uses Brent's root
+        finder on the same slope), a golden-section search on RA's values where the slope does not
+        change sign across the bracket.  Each variant's search stops on its own, so its result does
+        not depend on the other variants of the batch."""
         from .field_measures import RA_BAND_HZ
         lo, hi = RA_BAND_HZ
         f = np.linspace(lo, hi, 381)
@@ -269,30 +347,73 @@ class VariantBatch:
         best = self._ra_at(speed_mps, where[:, None], tire_scale)[:, 0]          # exact at the scan's best
         idx = np.flatnonzero((k > 0) & (k < f.size - 1))
         if idx.size:
-            g = (math.sqrt(5.0) - 1.0) / 2.0
             a, c = f[k[idx] - 1].astype(float), f[k[idx] + 1].astype(float)
-            x1, x2 = c - g * (c - a), a + g * (c - a)
-            both = self._ra_at(speed_mps, np.stack([x1, x2], axis=1), tire_scale, idx)
-            f1, f2 = both[:, 0], both[:, 1]
-            active = np.flatnonzero(c - a > 1e-12)
-            while active.size:
-                left = f1[active] > f2[active]                 # the maximum is in [a, x2], else in [x1, c]
-                aa, cc = a[active], c[active]
-                aa, cc = np.where(left, aa, x1[active]), np.where(left, x2[active], cc)
-                new = np.where(left, cc - g * (cc - aa), aa + g * (cc - aa))
-                f_new = self._ra_at(speed_mps, new[:, None], tire_scale, idx[active])[:, 0]
-                x1n = np.where(left, new, x2[active])
-                x2n = np.where(left, x1[active], new)
-                f1n = np.where(left, f_new, f2[active])
-                f2n = np.where(left, f1[active], f_new)
-                a[active], c[active], x1[active], x2[active], f1[active], f2[active] = aa, cc, x1n, x2n, f1n, f2n
-                active = active[cc - aa > 1e-12]
-            xm = np.clip(0.5 * (a + c), lo, hi)
+            ga = self._ra_slope(speed_mps, a, tire_scale, idx)
+            gc = self._ra_slope(speed_mps, c, tire_scale, idx)
+            root = (ga > 0) & (gc < 0)
+            xm = np.empty(idx.size)
+            if root.any():
+                r = np.flatnonzero(root)
+                xm[r] = self._slope_zero(speed_mps, tire_scale, idx[r], a[r], c[r], ga[r], gc[r])
+            if (~root).any():
+                r = np.flatnonzero(~root)
+                xm[r] = self._golden(speed_mps, tire_scale, idx[r], a[r], c[r])
+            xm = np.clip(xm, lo, hi)
             vm = self._ra_at(speed_mps, xm[:, None], tire_scale, idx)[:, 0]
             better = vm >= best[idx]
             best[idx] = np.where(better, vm, best[idx])
             where[idx] = np.where(better, xm, where[idx])
         return best, where
+
+    def _slope_zero(self, speed_mps, tire_scale, rows, a, c, ga, gc) -> np.ndarray:
+        """The zero of :meth:`_ra_slope` in [a, c] (ga > 0 > gc) of each variant of ``rows``:
+        Illinois regula falsi, each variant stopping when its iterate moves less than 1e-13 Hz."""
+        a, c, ga, gc = a.copy(), c.copy(), ga.copy(), gc.copy()
+        x = c - gc * (c - a) / (gc - ga)                 # the secant's zero (gc < 0 < ga: no 0 / 0)
+        side = np.zeros(a.size, int)                     # which end was kept last time (Illinois)
+        active = np.arange(a.size)
+        for _ in range(100):
+            if not active.size:
+                break
+            xa = x[active]
+            g = self._ra_slope(speed_mps, xa, tire_scale, rows[active])
+            pos = g > 0
+            # replace the end with the same sign; halve the other end's slope when kept twice
+            a[active] = np.where(pos, xa, a[active])
+            ga[active] = np.where(pos, g, np.where(side[active] == -1, 0.5 * ga[active], ga[active]))
+            c[active] = np.where(pos, c[active], xa)
+            gc[active] = np.where(pos, np.where(side[active] == 1, 0.5 * gc[active], gc[active]), g)
+            side[active] = np.where(pos, 1, -1)
+            aa, cc, gaa, gcc = a[active], c[active], ga[active], gc[active]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                new = cc - gcc * (cc - aa) / (gcc - gaa)
+            new = np.where((new > aa) & (new < cc), new, 0.5 * (aa + cc))
+            done = (np.abs(new - xa) <= 1e-13) | (g == 0) | (cc - aa <= 1e-13)
+            x[active] = np.where(g == 0, xa, new)
+            active = active[~done]
+        return x
+
+    def _golden(self, speed_mps, tire_scale, idx, a, c) -> np.ndarray:
+        """The golden-section search of RA's values over [a, c] of each variant of ``idx``, to 1e-12 Hz."""
+        a, c = a.copy(), c.copy()
+        g = (math.sqrt(5.0) - 1.0) / 2.0
+        x1, x2 = c - g * (c - a), a + g * (c - a)
+        both = self._ra_at(speed_mps, np.stack([x1, x2], axis=1), tire_scale, idx)
+        f1, f2 = both[:, 0], both[:, 1]
+        active = np.flatnonzero(c - a > 1e-12)
+        while active.size:
+            left = f1[active] > f2[active]                 # the maximum is in [a, x2], else in [x1, c]
+            aa, cc = a[active], c[active]
+            aa, cc = np.where(left, aa, x1[active]), np.where(left, x2[active], cc)
+            new = np.where(left, cc - g * (cc - aa), aa + g * (cc - aa))
+            f_new = self._ra_at(speed_mps, new[:, None], tire_scale, idx[active])[:, 0]
+            x1n = np.where(left, new, x2[active])
+            x2n = np.where(left, x1[active], new)
+            f1n = np.where(left, f_new, f2[active])
+            f2n = np.where(left, f1[active], f_new)
+            a[active], c[active], x1[active], x2[active], f1[active], f2[active] = aa, cc, x1n, x2n, f1n, f2n
+            active = active[cc - aa > 1e-12]
+        return 0.5 * (a + c)
 
     def ay_peaks(self, speed_mps: float, steer, t_end: float, dt: float, units=None,
                  tire_scale: float = 1.0) -> np.ndarray:
@@ -300,8 +421,9 @@ class VariantBatch:
         :meth:`_ay_peaks` (computed 64 variants at a time: the sampled states stay in cache,
         0.57 ms per variant for the single sine of aucnat against 2.6 ms one by one)."""
         B = self.size
+        G = RESPONSE_GROUP
         return np.concatenate([self._ay_peaks(speed_mps, steer, t_end, dt, units, tire_scale,
-                                              np.arange(i, min(B, i + 64))) for i in range(0, B, 64)])
+                                              np.arange(i, min(B, i + G))) for i in range(0, B, G)])
 
     def _pieces(self, speed_mps: float, steer, t_end: float, dt: float, tire_scale: float, rows: np.ndarray):
         """The exact response of the variants ``rows`` from rest to ``steer`` (not a lane change),
@@ -393,22 +515,29 @@ class VariantBatch:
         ``Z`` (B, count, dim) of one piece starting at sample time ``t0``: zeros of each signal's
         derivative located on its Hermite interpolant, valued by the quintic one (as
         :meth:`~lcvreport.analysis.exact.ManoeuvreResponse.extrema`).  Flat arrays (variant,
-        signal, time [s], value) and the signals' values at the samples (B, count, K)."""
+        signal, time [s], value) and the signals' values at the last sample (B, K)."""
         from .exact import _hermite_roots, _quintic
         C1 = C @ Mz
         C2 = C1 @ Mz
-        K = C.shape[1]
-        W = Z @ np.swapaxes(np.concatenate([C, C1, C2], axis=1), 1, 2)      # one product: (B, count, 3K)
-        Y, D1, D2 = W[..., :K], W[..., K:2 * K], W[..., 2 * K:]
-        change = ((D1[:, :-1] > 0) != (D1[:, 1:] > 0)) & ((D1[:, :-1] != 0) | (D1[:, 1:] != 0))
+        D1 = Z @ np.swapaxes(C1, 1, 2)                                     # the derivatives: (B, count, K)
+        pos = D1 > 0
+        change = pos[:, :-1] != pos[:, 1:]
+        nonzero = D1 != 0
+        if not nonzero.all():
+            change &= nonzero[:, :-1] | nonzero[:, 1:]
         b_i, k_i, s_i = np.nonzero(change)
+        y_last = np.einsum("bkd,bd->bk", C, Z[:, -1])
         if not b_i.size:
-            return b_i, s_i, np.zeros(0), np.zeros(0), Y
+            return b_i, s_i, np.zeros(0), np.zeros(0), y_last
         k1 = k_i + 1
-        tau = _hermite_roots(D1[b_i, k_i, s_i], D2[b_i, k_i, s_i], D1[b_i, k1, s_i], D2[b_i, k1, s_i], dt)
-        val = _quintic(Y[b_i, k_i, s_i], D1[b_i, k_i, s_i], D2[b_i, k_i, s_i], Y[b_i, k1, s_i], D1[b_i, k1, s_i],
-                       D2[b_i, k1, s_i], dt, tau)
-        return b_i, s_i, t0 + (k_i + tau) * dt, val, Y
+        Za, Zb = Z[b_i, k_i], Z[b_i, k1]                                   # the samples around each zero
+        c, c2 = C[b_i, s_i], C2[b_i, s_i]
+        ya, yb = np.einsum("nd,nd->n", Za, c), np.einsum("nd,nd->n", Zb, c)
+        sa, sb = np.einsum("nd,nd->n", Za, c2), np.einsum("nd,nd->n", Zb, c2)
+        da, db = D1[b_i, k_i, s_i], D1[b_i, k1, s_i]
+        tau = _hermite_roots(da, sa, db, sb, dt)
+        val = _quintic(ya, da, sa, yb, db, sb, dt, tau)
+        return b_i, s_i, t0 + (k_i + tau) * dt, val, y_last
 
     def _extremes(self, speed_mps: float, steer, t_end: float, dt: float, signals, tire_scale: float,
                   rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -423,11 +552,11 @@ class VariantBatch:
                 hi = np.full(C.shape[:2], -np.inf)
                 lo = np.full(C.shape[:2], np.inf)
             if Z is not None:
-                b_i, s_i, _t, val, Y = self._between_samples(Z, C, Mz, dt, ka * dt)
+                b_i, s_i, _t, val, y_last = self._between_samples(Z, C, Mz, dt, ka * dt)
                 np.maximum.at(hi, (b_i, s_i), val)
                 np.minimum.at(lo, (b_i, s_i), val)
                 if kb == n_steps:                                                  # the window's end
-                    hi, lo = np.maximum(hi, Y[:, -1]), np.minimum(lo, Y[:, -1])
+                    hi, lo = np.maximum(hi, y_last), np.minimum(lo, y_last)
             for z in (z0, z_end):                                                  # the piece's ends
                 if z is not None:
                     y = np.einsum("bkd,bd->bk", C, z)
@@ -492,8 +621,8 @@ class VariantBatch:
             C[:, 2, 1] += u
             return C
         hsto, ra = np.full(B, np.nan), np.full(B, np.nan)
-        for g in range(0, B, 64):
-            rows = np.arange(g, min(B, g + 64))
+        for g in range(0, B, RESPONSE_GROUP):
+            rows = np.arange(g, min(B, g + RESPONSE_GROUP))
             ok = self._inverse_stable(u, tire_scale, rows)
             rows = rows[ok]
             if not rows.size:
@@ -534,7 +663,7 @@ class VariantBatch:
         (:func:`lcvreport.analysis.field_measures.yaw_damping_coefficient`: the pulse, each joint's
         extrema from its end to 40 s after on the continuous response, the ratio method, the
         smallest over the joints); NaN where no joint has two amplitudes."""
-        from .field_measures import YDC_DT_S, YDC_PULSE, YDC_WINDOW_S, ratio_damping
+        from .field_measures import YDC_DT_S, YDC_PULSE, YDC_WINDOW_S
         from .manoeuvres import pulse
         v = self.vehicle
         B = self.size
@@ -546,8 +675,9 @@ class VariantBatch:
         t_end = round((D + YDC_WINDOW_S) / YDC_DT_S) * YDC_DT_S
         lo, hi = D + 1e-12, D + YDC_WINDOW_S - 1e-12
         joints = v.n_units - 1
-        for g in range(0, B, 64):
-            rows = np.arange(g, min(B, g + 64))
+        extrema = []
+        for g in range(0, B, RESPONSE_GROUP):
+            rows = np.arange(g, min(B, g + RESPONSE_GROUP))
             found = []
             for Mz, _z0, Z, _z_end, ka, _kb, _d, (_A, _b, m, n) in self._pieces(speed_mps, steer, t_end, YDC_DT_S,
                                                                                tire_scale, rows):
@@ -555,19 +685,15 @@ class VariantBatch:
                     continue
                 C = np.zeros((rows.size, joints, Mz.shape[-1]))                 # theta rows over z
                 C[:, np.arange(joints), v.n_units + 1 + np.arange(joints)] = 1.0
-                b_i, s_i, t, val, _Y = self._between_samples(Z, C, Mz, YDC_DT_S, ka * YDC_DT_S)
+                b_i, s_i, t, val, _y = self._between_samples(Z, C, Mz, YDC_DT_S, ka * YDC_DT_S)
                 keep = (t > lo) & (t < hi)
                 found.append((b_i[keep], s_i[keep], t[keep], val[keep]))
             b_i, s_i, t, val = (np.concatenate(a) for a in zip(*found))
-            order = np.lexsort((t, s_i, b_i))
-            b_i, s_i, val = b_i[order], s_i[order], val[order]
-            starts = np.flatnonzero(np.r_[True, (b_i[1:] != b_i[:-1]) | (s_i[1:] != s_i[:-1])])
-            ends = np.r_[starts[1:], b_i.size]
-            for a, e in zip(starts, ends):
-                zeta, _P = ratio_damping(val[a:e])
-                if zeta is not None:
-                    k = rows[b_i[a]]
-                    out[k] = zeta if np.isnan(out[k]) else min(out[k], zeta)
+            extrema.append((rows[b_i], s_i, t, val))
+        b_i, s_i, t, val = (np.concatenate(a) for a in zip(*extrema))
+        order = np.lexsort((t, s_i, b_i))                     # by variant, joint, time
+        zeta, b_of, _s = ratio_damping_groups(b_i[order], s_i[order], val[order])
+        np.fmin.at(out, b_of, zeta)                            # the smallest over a variant's joints
         return out
 
     def single_sine(self, speed_mps: float, f_hz: float | None = None, tire_scale: float = 1.0) -> np.ndarray:
