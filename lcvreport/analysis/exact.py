@@ -157,15 +157,12 @@ class ManoeuvreResponse:
             if t.size > 1:
                 D1 = c1.T @ seg.Z.T                           # the derivatives at the samples: (K, samples)
                 pos = D1 > 0
-                # a sign change of the derivative, or a zero of it at a sample (not a flat stretch),
-                # in an interval that reaches into the window
+                # a sign change of the derivative (one side > 0, the other <= 0: a flat stretch of
+                # zeros is none), in an interval that reaches into the window
                 change = pos[:, :-1] != pos[:, 1:]
-                nonzero = D1 != 0
-                if not nonzero.all():
-                    change &= nonzero[:, :-1] | nonzero[:, 1:]
                 if t[0] < t_from or t[-1] > t_to:
                     change &= (t[1:] >= t_from) & (t[:-1] <= t_to)
-                sig, k = np.nonzero(change)                   # by signal, then by time
+                sig, k = np.divmod(np.flatnonzero(change), t.size - 1)   # by signal, then by time
                 if k.size:
                     k1 = k + 1
                     W = np.concatenate([c, c2], axis=1)       # values and second derivatives, at the ends only
