@@ -425,27 +425,31 @@ class VariantBatch:
         return np.concatenate([self._ay_peaks(speed_mps, steer, t_end, dt, units, tire_scale,
                                               np.arange(i, min(B, i + G))) for i in range(0, B, G)])
 
-    def _pieces(self, speed_mps: float, steer, t_end: float, dt: float, tire_scale: float, rows: np.ndarray):
+    def _pieces(self, speed_mps: float, steer, t_end: float, dt: float, tire_scale: float, rows: np.ndarray,
+                positions: bool = True):
         """The exact response of the variants ``rows`` from rest to ``steer`` (not a lane change),
         piece by piece as :func:`lcvreport.analysis.exact.response` computes it: yields per piece
         ``(Mz, z0, Z, z_end, ka, kb, d_row, ctx)`` with the augmented matrices (B, dim, dim) over
         ``z = [x, psi1, Y1, xi, 1]``, the state at the piece's start, the samples ``ka..kb`` (B,
         count, dim; None if the piece holds no sample), the state at its end (None: it lasts past
-        t_end), the steer's row over z, and ``ctx`` (A_x, bd_x, m, n)."""
+        t_end), the steer's row over z, and ``ctx`` (A_x, bd_x, m, n).  ``positions=False`` leaves
+        psi1 and Y1 out (``z = [x, xi, 1]``, m = n): they integrate x and feed nothing back, and
+        signals of x and the steer alone (accelerations, articulation angles) do not need them."""
         from scipy.linalg import expm
         c = {k: a[rows] for k, a in self.coefficients.items()}
         u = float(speed_mps)
         n, B = self.vehicle.n_states, rows.size
-        m = n + 2
+        m = n + 2 if positions else n
         M = c["M0"] + u * c["M1"]
         S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
         AG = solve_scaled(M, np.concatenate([S, np.broadcast_to(np.eye(n), (B, n, n))], axis=-1))
         A_x, Minv = AG[..., :n], AG[..., n:]
         Aa = np.zeros((B, m, m))
         Aa[:, :n, :n] = A_x
-        Aa[:, n, 1] = 1.0
-        Aa[:, n + 1, 0] = 1.0
-        Aa[:, n + 1, n] = u
+        if positions:
+            Aa[:, n, 1] = 1.0
+            Aa[:, n + 1, 0] = 1.0
+            Aa[:, n + 1, n] = u
         bd_x = np.zeros((B, m))
         bd_x[:, :n] = np.einsum("bij,bj->bi", Minv, tire_scale * c["Bdelta"])
         ctx = (A_x, bd_x, m, n)
@@ -539,13 +543,14 @@ class VariantBatch:
         return b_i, s_i, t0 + (k_i + tau) * dt, val, y_last
 
     def _extremes(self, speed_mps: float, steer, t_end: float, dt: float, signals, tire_scale: float,
-                  rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                  rows: np.ndarray, positions: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """(largest, smallest) value of the signals over the continuous response on [0, t_end]
         among its extrema, the pieces' ends and the window's ends (as ``extrema``), shape (B, K);
         ``signals(Mz, d_row, ctx)`` gives the signals' rows over z (B, K, dim) for a piece."""
         n_steps = int(round(t_end / dt))
         hi = lo = None
-        for Mz, z0, Z, z_end, ka, kb, d_row, ctx in self._pieces(speed_mps, steer, t_end, dt, tire_scale, rows):
+        for Mz, z0, Z, z_end, ka, kb, d_row, ctx in self._pieces(speed_mps, steer, t_end, dt, tire_scale, rows,
+                                                                 positions):
             C = signals(Mz, d_row, ctx)
             if hi is None:
                 hi = np.full(C.shape[:2], -np.inf)
@@ -580,7 +585,8 @@ class VariantBatch:
     def _ay_peaks(self, speed_mps: float, steer, t_end: float, dt: float, units, tire_scale: float,
                   rows: np.ndarray) -> np.ndarray:
         units = list(range(self.vehicle.n_units)) if units is None else list(units)
-        hi, lo = self._extremes(speed_mps, steer, t_end, dt, self._ay_rows(speed_mps, units), tire_scale, rows)
+        hi, lo = self._extremes(speed_mps, steer, t_end, dt, self._ay_rows(speed_mps, units), tire_scale, rows,
+                                positions=False)                          # accelerations: no psi1, Y1
         return np.maximum(np.abs(hi), np.abs(lo))
 
     def lane_change(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -679,7 +685,7 @@ class VariantBatch:
             rows = np.arange(g, min(B, g + RESPONSE_GROUP))
             found = []
             for Mz, _z0, Z, _z_end, ka, _kb, _d, (_A, _b, m, n) in self._pieces(speed_mps, steer, t_end, YDC_DT_S,
-                                                                               tire_scale, rows):
+                                                                               tire_scale, rows, positions=False):
                 if Z is None:
                     continue
                 C = np.zeros((rows.size, joints, Mz.shape[-1]))                 # theta rows over z
