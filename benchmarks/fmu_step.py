@@ -26,7 +26,6 @@ from __future__ import annotations
 import subprocess
 import sys
 import tempfile
-import time
 import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path

@@ -403,15 +403,17 @@ def part1(B, n_loop, rounds):
         fl.append(timed(lambda: full_loop(few))[0] / n_loop)
     table = full_batch(batch)
     ss, ydc, (hsto, ra_lc) = twin.single_sine(), twin.yaw_damping(), twin.lane_change()
-    agree = {k: float(np.nanmax(np.abs(x - table[k]) / np.abs(table[k])))
+    agree = {k: np.abs(x - table[k]) / np.abs(table[k])
              for k, x in (("ra_single_sine", ss), ("yaw_damping_coefficient", ydc), ("hsto_m", hsto),
                           ("ra_lane_change", ra_lc))}
     print("   the whole measure set (+ single sine, YDC, HSTO, lane-change RA; the trim aside):")
     print(f"   VariantBatch.measures        {min(fb) * 1e3:7.3f}")
-    print(f"   vectorised twin (this file)  {min(ft) * 1e3:7.3f}   batch/twin {min(fb) / min(ft):5.2f}  (target <= 1.2)")
-    print(f"   loop of measure_set          {min(fl) * 1e3:7.3f}   batch/loop {min(fb) / min(fl):5.2f}  (target <= 0.4)")
-    print("   agreement with the twin's sampled peaks (parabola through three samples): "
-          + ", ".join(f"{k} {x:.0e}" for k, x in agree.items()))
+    b_, t_, l_ = min(fb), min(ft), min(fl)
+    print(f"   vectorised twin (this file)  {t_ * 1e3:7.3f}   batch/twin {b_ / t_:5.2f}  (target <= 1.2)")
+    print(f"   loop of measure_set          {l_ * 1e3:7.3f}   batch/loop {b_ / l_:5.2f}  (target <= 0.4)")
+    print("   agreement with the twin's sampled peaks (parabola through three samples), relative, median / "
+          "largest: " + ", ".join(f"{k} {np.nanmedian(x):.0e} / {np.nanmax(x):.0e}" for k, x in agree.items()))
+    print("   (the YDC's largest: a variant whose sampled extrema the twin finds otherwise near the 5 % rule)")
     return min(fb)
 
 

@@ -79,7 +79,7 @@ def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RAPe
     f = np.linspace(lo, hi, 381)
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
-    co = system_coefficients(vehicle)           # once: Brent's method asks for ~25 single frequencies
+    co = system_coefficients(vehicle)           # once: the search asks for ~10 single frequencies
     u = float(speed_mps)
     M, S, b = co.M(u), co.S(u, tire_scale), co.B_delta(tire_scale)
     ends = np.array([0, vehicle.n_units - 1])
@@ -94,7 +94,8 @@ def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RAPe
         return G[..., -1] / G[..., 0]
 
     def ra1(x: float) -> float:
-        """RA at one frequency x [Hz] (Brent's steps): the same solve, without the stacking."""
+        """RA at one frequency x [Hz] (the peak's value, the fallback search): the same solve
+        without the stacking."""
         w = 2 * np.pi * x
         z = np.linalg.solve(1j * w * M - S, b)
         G = np.abs(V @ z * (1j * w) + u * (R @ z))
