@@ -154,7 +154,10 @@ class SystemCoefficients:
             A.setflags(write=False)
             G.setflags(write=False)
             if len(memo) >= MAPS_KEPT:
-                memo.pop(next(iter(memo)))
+                try:                                    # the oldest out (another thread may be at it too)
+                    memo.pop(next(iter(memo)), None)
+                except (RuntimeError, StopIteration):
+                    pass
             memo[key] = (A, G)
         return A, G
 
