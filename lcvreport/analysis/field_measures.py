@@ -107,6 +107,7 @@ def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RAPe
     k = int(np.argmax(values))
     if k in (0, f.size - 1):
         return RAPeak(float(values[k]), float(f[k]))
+
     def slope(x: float) -> float:
         """d ln RA / d omega at x [Hz] (the sign of dRA/df)."""
         w = 2 * np.pi * x
