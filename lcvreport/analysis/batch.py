@@ -484,6 +484,12 @@ class VariantBatch:
                 d_row[m:m + p] = piece.h
             Mz[:, m:m + p, m:m + p] = piece.E
             z0 = np.concatenate([z_state, np.broadcast_to(piece.xi0, (B, p)), np.ones((B, 1))], axis=1)
+            if not np.any(piece.h):
+                # no input (the tail after a pulse, a sine, a lane change): [xi, 1] reach neither x nor
+                # the signals (no residual force here), so the piece runs on [x, (psi1, Y1)] alone
+                Mz, z0 = np.ascontiguousarray(Mz[:, :m, :m]), z0[:, :m]
+                d_row = d_row[..., :m]
+                dim = m
             t1 = piece.t1
             ka = int(math.ceil(piece.t0 / dt - 1e-9))
             kb = n_steps if t1 > t_end + 1e-12 else int(math.ceil(t1 / dt - 1e-9)) - 1
