@@ -264,3 +264,15 @@ def test_the_grouped_ratio_method_equals_the_one_signal_method():
     assert got.keys() == expected.keys() and len(expected) > 60
     for k, zeta in expected.items():
         assert got[k] == pytest.approx(zeta, rel=1e-14, abs=1e-16)
+
+
+def test_the_batched_ra_peak_falls_back_to_a_golden_section_where_the_slope_brackets_no_zero(monkeypatch):
+    v = load_preset("aucnat")
+    names = [f"{u.name}.mass_kg" for u in v.units]
+    rng = np.random.default_rng(3)
+    values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 5) for n in names}
+    peak, where = VariantBatch(v, values).ra_peak(24.0)
+    monkeypatch.setattr(VariantBatch, "_ra_slope", lambda self, s, x, t, rows: np.full(len(rows), np.nan))
+    peak2, where2 = VariantBatch(v, values).ra_peak(24.0)
+    np.testing.assert_allclose(peak2, peak, rtol=1e-13)
+    assert np.max(np.abs(where2 - where)) <= 1e-7

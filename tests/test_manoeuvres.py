@@ -133,6 +133,18 @@ def test_ra_peak_frequency_is_the_vertex_of_an_independent_parabola(name, kph):
     assert p.value == pytest.approx(r[1], rel=1e-13)
 
 
+def test_ra_peak_falls_back_to_a_value_search_where_the_slope_brackets_no_zero(monkeypatch):
+    # a slope that is NaN everywhere: the search on RA's values finds the same peak (to its
+    # own precision, ~sqrt(eps) of the frequency on a flat maximum)
+    import scipy.linalg
+    v = load_preset("aucnat")
+    p = fm.ra_peak(v, U88)
+    monkeypatch.setattr(scipy.linalg, "lu_solve", lambda lu, b: np.full(np.shape(b), np.nan, dtype=complex))
+    q = fm.ra_peak(v, U88)
+    assert q.value == pytest.approx(p.value, rel=1e-13)
+    assert abs(q.frequency_hz - p.frequency_hz) <= 1e-7
+
+
 def test_the_ratio_method_of_one_damped_mode_is_its_modal_damping_ratio():
     for lam in (-0.3 + 2.0j, -1.2 + 7.5j, -0.05 + 0.9j):
         t = (np.arange(9) * np.pi - np.angle(lam)) / lam.imag        # extrema of exp(sigma t) sin(omega t)
