@@ -13,6 +13,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``cache``            an LRU cache (discretizations, output maps)
     ``numerics``         numpy-only numerics: equilibrated solve, expm
     ``threads``          one BLAS thread at the entry points (LCV_BLAS_THREADS to change it)
+    ``files``            the one guarded reader of every file a user hands in (regular files, a size limit, UTF-8)
 ``model/``               **the model core** (numpy only):
     ``vehicle``          Axle, Unit, Vehicle (SI parameter sets, validated)
     ``vehicle_file``     vehicle files (TOML, SI): load_vehicle, dumps_vehicle

@@ -247,7 +247,9 @@ def build_parser() -> argparse.ArgumentParser:
                                                                "earlier results (then only missing chunks run)")
     where = st.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, metavar="N", help="a local Dask cluster of N worker processes")
-    where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (tcp://host:8786)")
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="an existing Dask scheduler (tcp://host:8786). Connect only to a cluster you trust: "
+                            "Dask's messages carry pickles, so a scheduler runs what it likes in this process")
     st.add_argument("--csv", action="store_true", help="also write DIR/results.csv (one row per case)")
     st.add_argument("--report", metavar="REPORT_DIR", help="then write the study report (HTML, PDF) into REPORT_DIR: "
                                                            "new, empty or an earlier report")
@@ -873,8 +875,14 @@ def _cmd_study(args, out: _Out) -> int:
     try:
         study = load_study(args.study_file)
     except StudyError as exc:
-        raise UsageError(f"{args.study_file}: {exc}") from None
+        raise UsageError(str(exc) if str(args.study_file) in str(exc) else f"{args.study_file}: {exc}") from None
     out_dir = Path(args.out)
+    if args.scheduler is not None:
+        from .study.run import check_scheduler_address
+        try:
+            check_scheduler_address(args.scheduler)
+        except StudyError as exc:
+            raise UsageError(f"argument {exc}") from None
     if (args.criteria is not None or args.no_pdf) and args.report is None:
         raise UsageError("arguments --criteria and --no-pdf belong to --report REPORT_DIR")
     if args.report is not None:

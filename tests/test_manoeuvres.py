@@ -244,7 +244,7 @@ def test_bad_manoeuvre_options_are_one_line_and_exit_2(args, fragment):
 @pytest.mark.parametrize("content, fragment", [
     ("time_s,delta_rad\n0,0\n1,0.01\n1,0.02\n", "must increase strictly"),
     ("time_s,delta_rad\n0,0\n1,nan\n", "not finite"),
-    ("t,d\n0,0\n", "header time_s,delta_rad"),
+    ("t,d\n0,0\n", "unknown column 't'; columns: time_s, delta_rad"),
     ("time_s,delta_rad\n0,0\n1,2\n", "must be in [-1, 1] rad"),
 ])
 def test_a_bad_steer_table_is_refused(tmp_path, content, fragment):

@@ -162,7 +162,7 @@ def test_tires_file_gives_the_axle_loads_a_hand_computation_gives(tmp_path, suff
 
 
 @pytest.mark.parametrize("content, fragment", [
-    ("position,conicity_N,ply_steer_N\n61:left_outer,1,2\n", "missing 'serial_side'"),
+    ("position,conicity_N,ply_steer_N\n61:left_outer,1,2\n", "missing column 'serial_side'"),
     ("position,conicity_N,ply_steer_N,serial_side\n61:left_outer,x,2,out\n", "must be a number"),
     ("position,conicity_N,ply_steer_N,serial_side\n61:left_outer,1,2,up\n", "serial_side must be out or in"),
     ("position,conicity_N,ply_steer_N,serial_side\n99:left,1,2,out\n", "unknown axle '99'"),

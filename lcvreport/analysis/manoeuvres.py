@@ -25,7 +25,6 @@ Examples
 """
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,11 +32,14 @@ from pathlib import Path
 import numpy as np
 
 from ..ranges import RANGES, RangeError
+from ..util.files import FileInputError, read_csv
 
 #: standard gravity [m/s^2]
 G_MPS2 = 9.80665
 #: the largest number of rows of a steer table
 MAX_TABLE_ROWS = 1_000_000
+#: the largest steer table file [bytes] (10^6 rows of two numbers of full precision)
+TABLE_MAX_BYTES = 64 << 20
 
 
 class SteerError(ValueError):
@@ -188,26 +190,20 @@ def table(time_s, delta_rad, source: str = "table") -> SteerInput:
 
 
 def read_table(path: str | Path) -> SteerInput:
-    """A steer table from a CSV file with the header ``time_s,delta_rad``."""
-    path = Path(path)
+    """A steer table from a CSV file with the header ``time_s,delta_rad`` (a regular file of
+    at most :data:`TABLE_MAX_BYTES`, :func:`lcvreport.util.files.read_csv`)."""
     try:
-        with open(path, newline="", encoding="utf-8") as f:
-            rows = list(csv.reader(f))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SteerError(f"csv:{path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") from None
-    if not rows or [c.strip() for c in rows[0]] != ["time_s", "delta_rad"]:
-        raise SteerError(f"csv:{path}: the first line must be the header time_s,delta_rad")
+        rows = read_csv(path, "steer table", ("time_s", "delta_rad"), max_bytes=TABLE_MAX_BYTES)
+    except FileInputError as exc:
+        raise SteerError(f"csv:{exc}") from None
     t, d = [], []
-    for k, row in enumerate(rows[1:], start=2):
-        if not row or all(not c.strip() for c in row):
-            continue
-        if len(row) != 2:
-            raise SteerError(f"csv:{path}: line {k} must have two columns, got {len(row)}")
+    for k, row in rows:
         try:
-            t.append(float(row[0]))
-            d.append(float(row[1]))
+            t.append(float(row["time_s"]))
+            d.append(float(row["delta_rad"]))
         except ValueError:
-            raise SteerError(f"csv:{path}: line {k} is not two numbers: {','.join(row)!r}") from None
+            raise SteerError(f"csv:{path}: line {k} is not two numbers: {row['time_s']},{row['delta_rad']!r}") \
+                from None
     return table(t, d, source=str(path))
 
 

@@ -131,28 +131,13 @@ def read_measured_tires(path) -> list[dict]:
     >>> [t["id"] for t in read_measured_tires(p)]
     ['A1', 'A2']
     """
-    import csv
-    from pathlib import Path
-    path = Path(path)
+    from ..util.files import FileInputError, read_csv
     try:
-        if not path.is_file():
-            raise TrackingError(f"{path}: not a regular file")
-        if path.stat().st_size > 1 << 20:
-            raise TrackingError(f"{path}: larger than 1 MiB")
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TrackingError(f"{path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") from None
-    reader = csv.DictReader(text.splitlines())
-    header = reader.fieldnames or []
-    unknown = [c for c in header if c not in COLUMNS + OPTIONAL]
-    missing = [c for c in COLUMNS if c not in header]
-    if unknown or missing:
-        raise TrackingError(f"{path}: " + (f"unknown column {unknown[0]!r}" if unknown else f"missing column "
-                                            f"{missing[0]!r}") + f"; columns: {', '.join(COLUMNS + OPTIONAL)}")
+        rows = read_csv(path, "measured-tire file", COLUMNS, OPTIONAL)
+    except FileInputError as exc:
+        raise TrackingError(str(exc)) from None
     tires, seen = [], {}
-    for k, row in enumerate(reader, start=2):
-        if None in row:
-            raise TrackingError(f"{path}: line {k}: more values than columns")
+    for k, row in rows:
         tid = (row["id"] or "").strip()
         if not tid or not tid.isprintable():
             raise TrackingError(f"{path}: line {k}: id must be a non-empty printable text, got {row['id']!r}")

@@ -212,6 +212,8 @@ def axle_residuals(vehicle: Vehicle, mounted: list[dict]):
 #: columns of a mounted-tires file
 TIRE_COLUMNS = ("position", "conicity_N", "ply_steer_N", "serial_side")
 TIRE_OPTIONAL = ("id", "conicity_moment_Nm", "ply_steer_moment_Nm")
+#: the largest tire file [bytes] (a fleet's tires, one line each)
+TIRE_FILE_MAX_BYTES = 4 << 20
 
 
 def tire_number(raw, where: str) -> float:
@@ -236,23 +238,25 @@ def read_mounted_tires(path) -> list[dict]:
         Unreadable file, unknown or missing columns, non-numbers, non-finite values,
         a serial side other than out or in.
     """
-    import csv
     import tomllib
     from pathlib import Path
+    from ..util.files import FileInputError, read_csv, read_text_file
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TrackingError(f"{path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") from None
-    if path.suffix.lower() == ".toml":
-        try:
-            rows = tomllib.loads(text).get("tires")
-        except tomllib.TOMLDecodeError as exc:
-            raise TrackingError(f"{path}: not valid TOML: {exc}") from None
-        if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
-            raise TrackingError(f"{path}: expected [[tires]] tables")
-    else:
-        rows = list(csv.DictReader(text.splitlines()))
+        if path.suffix.lower() == ".toml":
+            try:
+                rows = tomllib.loads(read_text_file(path, "tire file", TIRE_FILE_MAX_BYTES)).get("tires")
+            except (tomllib.TOMLDecodeError, ValueError) as exc:
+                if isinstance(exc, FileInputError):
+                    raise
+                raise TrackingError(f"{path}: not valid TOML: {exc}") from None
+            if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
+                raise TrackingError(f"{path}: expected [[tires]] tables")
+        else:
+            rows = [row for _line, row in read_csv(path, "tire file", TIRE_COLUMNS, TIRE_OPTIONAL,
+                                                   TIRE_FILE_MAX_BYTES)]
+    except FileInputError as exc:
+        raise TrackingError(str(exc)) from None
     out = []
     for k, row in enumerate(rows, start=1):
         unknown = set(row) - set(TIRE_COLUMNS) - set(TIRE_OPTIONAL)

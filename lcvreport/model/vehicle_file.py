@@ -63,12 +63,11 @@ lcvreport.model.vehicle_file.VehicleFileError: units[0] "truck" axles[0] "front"
 """
 from __future__ import annotations
 
-import os
-import stat
 import tomllib
 import unicodedata
 from pathlib import Path
 
+from ..util.files import FileInputError, read_text_file
 from .vehicle import Axle, Unit, Vehicle, VehicleError
 
 #: the format tag of version 1
@@ -203,7 +202,8 @@ def _check_key_lengths(text: str) -> None:
 
 
 def read_vehicle_text(path: str | Path) -> str:
-    """The text of a vehicle file: a regular file of at most :data:`MAX_FILE_BYTES`, UTF-8.
+    """The text of a vehicle file: a regular file of at most :data:`MAX_FILE_BYTES`, UTF-8
+    (:func:`lcvreport.util.files.read_text_file`).
 
     A FIFO, a device (``/dev/zero``) or a folder is refused without reading from it.
 
@@ -211,29 +211,10 @@ def read_vehicle_text(path: str | Path) -> str:
     ------
     VehicleFileError
     """
-    path = Path(path)
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-    except OSError as exc:
-        raise VehicleFileError("", f"cannot read {path}: {exc.strerror}") from None
-    try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise VehicleFileError("", f"{path} is not a regular file (a vehicle file is a TOML text file)")
-        if st.st_size > MAX_FILE_BYTES:
-            raise VehicleFileError("", f"{path} has {st.st_size} bytes; a vehicle file has at most {MAX_FILE_BYTES}")
-        with os.fdopen(fd, "rb", closefd=False) as f:
-            data = f.read(MAX_FILE_BYTES + 1)
-    except OSError as exc:
-        raise VehicleFileError("", f"cannot read {path}: {exc.strerror}") from None
-    finally:
-        os.close(fd)
-    if len(data) > MAX_FILE_BYTES:
-        raise VehicleFileError("", f"{path} has more than {MAX_FILE_BYTES} bytes")
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise VehicleFileError("", f"{path} is not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+        return read_text_file(path, "vehicle file", MAX_FILE_BYTES)
+    except FileInputError as exc:
+        raise VehicleFileError("", str(exc)) from None
 
 
 def load_vehicle(path: str | Path) -> Vehicle:

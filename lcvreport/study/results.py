@@ -26,13 +26,40 @@ from .run import CHUNKS, MANIFEST, STUDY, chunk_name
 from .spec import StudyError, study_from_stored
 
 
-def _manifest(folder: Path) -> dict:
+def _json(path: Path) -> dict:
+    """A JSON document of a study folder (through the guarded reader: a FIFO never blocks)."""
+    from ..util.files import read_text_file
     try:
-        return json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise StudyError(f"{folder} holds no study results ({MANIFEST} is missing)") from None
-    except (OSError, ValueError) as exc:
-        raise StudyError(f"{folder / MANIFEST} cannot be read: {exc}") from None
+        doc = json.loads(read_text_file(path, "study's JSON file", 64 << 20))
+    except ValueError as exc:
+        raise StudyError(f"{path} cannot be read: {exc}") from None
+    if not isinstance(doc, dict):
+        raise StudyError(f"{path} cannot be read: not a JSON object")
+    return doc
+
+
+def _manifest(folder: Path) -> dict:
+    if not (folder / MANIFEST).exists():
+        raise StudyError(f"{folder} holds no study results ({MANIFEST} is missing)")
+    return _json(folder / MANIFEST)
+
+
+def _checked(folder: Path) -> tuple[dict, object]:
+    """The manifest and the stored study of ``folder``, checked against each other: the
+    manifest must describe the study that ``study.json`` holds (its digest, its cases and
+    chunks), so an edited manifest cannot make part of a study read as all of it."""
+    from .run import FORMAT
+    man = _manifest(folder)
+    study = stored_study(folder)
+    if man.get("format") != FORMAT or man.get("study_sha256") != study.digest():
+        raise StudyError(f"{folder / MANIFEST} does not describe the study in {folder / STUDY} (another study's, "
+                         "or changed); the results cannot be trusted: run the study again into a new folder")
+    for key, want in (("n_cases", study.n_cases), ("chunk_size", study.chunk), ("n_chunks", study.n_chunks),
+                      ("columns", ["case_id"] + [f.name for f in study.factors] + list(study.measures))):
+        if man.get(key) != want:
+            raise StudyError(f"{folder / MANIFEST}: {key} is {man.get(key)!r} but the study has {want!r} (the "
+                             "manifest was changed); run the study again into a new folder")
+    return man, study
 
 
 def read_study(folder, complete: bool = True):
@@ -40,25 +67,56 @@ def read_study(folder, complete: bool = True):
     ``case_id``, one column per factor (its name in the study file), one per measure (the
     ``lcv measures --json`` keys; NaN where undefined).
 
+    Every chunk is checked before its rows are used: its metadata (the study's digest, its
+    chunk number and case range), its row count, its page checksums and its ``case_id``
+    column; a chunk that fails is named (a rerun of ``lcv study`` with the same ``--out``
+    computes it again).
+
     Parameters
     ----------
     folder : path
         The ``--out`` folder of ``lcv study``.
     complete : bool
         Refuse a study with chunks still missing (default); False reads what is there.
+
+    Raises
+    ------
+    StudyError
+        A folder without results, a manifest that does not describe its study, missing
+        chunks (when ``complete``), a damaged or foreign chunk.
     """
+    import numpy as np
     import pandas as pd
     import pyarrow.parquet as pq
+    from .run import chunk_problem
     folder = Path(folder)
-    man = _manifest(folder)
+    man, study = _checked(folder)
     chunks = folder / CHUNKS
-    present = [k for k in range(man["n_chunks"]) if (chunks / chunk_name(k)).is_file()]
-    if complete and len(present) < man["n_chunks"]:
-        raise StudyError(f"{folder}: {man['n_chunks'] - len(present)} of {man['n_chunks']} chunks are missing; "
+    n, size, digest = study.n_cases, study.chunk, study.digest()
+    present = [k for k in range(study.n_chunks) if (chunks / chunk_name(k)).exists()]
+    if complete and len(present) < study.n_chunks:
+        raise StudyError(f"{folder}: {study.n_chunks - len(present)} of {study.n_chunks} chunks are missing; "
                          "rerun lcv study with the same --out to complete it (or read_study(..., complete=False))")
     if not present:
         return pd.DataFrame({c: [] for c in man["columns"]})
-    table = pd.concat([pq.read_table(chunks / chunk_name(k)).to_pandas() for k in present], ignore_index=True)
+    parts = []
+    for k in present:
+        path = chunks / chunk_name(k)
+        start, stop = k * size, min(n, (k + 1) * size)
+        why = chunk_problem(path, digest, k, start, stop) if path.is_file() else "is not a regular file"
+        if why is None:
+            try:
+                part = pq.read_table(path, page_checksum_verification=True).to_pandas()
+            except Exception as exc:  # noqa: BLE001 - a damaged file, whatever pyarrow calls it
+                why = f"is damaged ({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})"
+            else:
+                if list(part.columns) != man["columns"] or \
+                        not np.array_equal(part["case_id"].to_numpy(), np.arange(start, stop)):
+                    why = f"does not hold the cases {start}..{stop - 1} it says it holds"
+        if why is not None:
+            raise StudyError(f"{path} {why}; rerun lcv study with the same --out to compute it again")
+        parts.append(part)
+    table = pd.concat(parts, ignore_index=True)
     return table[man["columns"]].sort_values("case_id", kind="stable").reset_index(drop=True)
 
 
@@ -66,11 +124,7 @@ def stored_study(folder):
     """The :class:`~lcvreport.study.spec.Study` whose results are in ``folder`` (as it was run)."""
     folder = Path(folder)
     _manifest(folder)
-    try:
-        doc = json.loads((folder / STUDY).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise StudyError(f"{folder / STUDY} cannot be read: {exc}") from None
-    return study_from_stored(doc)
+    return study_from_stored(_json(folder / STUDY))
 
 
 def study_case(folder, case_id: int):

@@ -50,7 +50,8 @@ def chunk_name(k: int) -> str:
 
 @dataclass
 class RunSummary:
-    """What a run did: chunks computed now, chunks found done, cases, seconds."""
+    """What a run did: chunks computed now (``n_repaired`` of them replacing a damaged or
+    foreign file), chunks found done, cases, seconds."""
 
     out: Path
     n_chunks: int
@@ -58,6 +59,7 @@ class RunSummary:
     n_found: int
     n_cases: int
     seconds: float
+    n_repaired: int = 0
 
 
 def _chunk_job(study_doc: dict, k: int, start: int, stop: int, folder: str) -> int:
@@ -68,18 +70,30 @@ def _chunk_job(study_doc: dict, k: int, start: int, stop: int, folder: str) -> i
     return k
 
 
+#: the chunk metadata keys (Parquet key-value metadata): what a chunk holds, checked on every read
+CHUNK_META = ("lcv.study_sha256", "lcv.chunk", "lcv.cases")
+
+
+def _chunk_metadata(digest: str, k: int, start: int, stop: int) -> dict:
+    return {"lcv.study_sha256": digest, "lcv.chunk": str(k), "lcv.cases": f"{start}:{stop}"}
+
+
 def write_chunk(study: Study, k: int, start: int, stop: int, folder: Path) -> Path:
-    """Compute and write ``chunks/chunk-k.parquet`` under a temporary name, then rename it."""
+    """Compute and write ``chunks/chunk-k.parquet`` under a temporary name, then rename it.
+
+    The file carries what it holds -- the study's digest, its chunk number and case range --
+    and page checksums, so that a chunk copied over another, cut short or damaged is found
+    (:func:`chunk_problem`) instead of read as results."""
     import numpy as np
     import pyarrow as pa
     import pyarrow.parquet as pq
     from .compute import compute_chunk
     cols = compute_chunk(study, np.arange(start, stop))
-    table = pa.table(cols)
+    table = pa.table(cols).replace_schema_metadata(_chunk_metadata(study.digest(), k, start, stop))
     final = folder / chunk_name(k)
     tmp = folder / f".{chunk_name(k)}.{os.getpid()}.tmp"
     try:
-        pq.write_table(table, tmp)
+        pq.write_table(table, tmp, write_page_checksum=True)
         os.replace(tmp, final)
     finally:
         if tmp.exists():
@@ -87,33 +101,95 @@ def write_chunk(study: Study, k: int, start: int, stop: int, folder: Path) -> Pa
     return final
 
 
+def chunk_problem(path: Path, digest: str, k: int, start: int, stop: int) -> str | None:
+    """Why the chunk file ``path`` is not chunk ``k`` (cases ``start..stop-1``) of the study
+    with ``digest``, or None when its footer says it is (the metadata and the row count: no
+    data is read)."""
+    import pyarrow.parquet as pq
+    try:
+        md = pq.read_metadata(path)
+    except Exception as exc:  # noqa: BLE001 - any failure to read the footer: a damaged file
+        return f"cannot be read ({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})"
+    meta = {key.decode(errors="replace"): val.decode(errors="replace") for key, val in (md.metadata or {}).items()}
+    want = _chunk_metadata(digest, k, start, stop)
+    if meta.get("lcv.study_sha256") != want["lcv.study_sha256"]:
+        return "belongs to another study (or was written by an older lcvreport)"
+    if meta.get("lcv.chunk") != want["lcv.chunk"] or meta.get("lcv.cases") != want["lcv.cases"]:
+        return (f"holds chunk {meta.get('lcv.chunk')} (cases {meta.get('lcv.cases')}), not chunk {k} "
+                f"(cases {want['lcv.cases']})")
+    if md.num_rows != stop - start:
+        return f"holds {md.num_rows} rows, not {stop - start}"
+    return None
+
+
+#: what an interrupted set-up of a study folder can leave (ours: a rerun clears it)
+SETUP_LEFTOVERS = (STUDY, f".{STUDY}.tmp", f".{MANIFEST}.tmp", CHUNKS)
+
+
+def _write_json(out: Path, name: str, text: str) -> None:
+    """Write ``out/name`` whole or not at all (a full disk leaves no partial file)."""
+    tmp = out / f".{name}.tmp"
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, out / name)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def _only_setup_leftovers(out: Path) -> bool:
+    """True when ``out`` holds nothing but what an interrupted set-up of a study writes
+    (``study.json`` before its manifest, their temporary files, an empty chunks folder)."""
+    entries = list(out.iterdir())
+    if any(e.name not in SETUP_LEFTOVERS for e in entries):
+        return False
+    chunks = out / CHUNKS
+    if chunks.is_symlink() or (chunks.exists() and not chunks.is_dir()):
+        return False
+    return not chunks.exists() or all(c.name.startswith(".chunk-") and c.name.endswith(".tmp")
+                                      for c in chunks.iterdir())
+
+
 def _prepare(study: Study, out: Path) -> Path:
-    """Create or check the output folder; the chunks folder."""
+    """Create or check the output folder; the chunks folder.  ``study.json`` is written
+    first and ``manifest.json`` last: a folder with a manifest is set up; one holding only
+    what an interrupted set-up leaves (a full disk, Ctrl-C) is set up again."""
+    import shutil
     doc = study.to_dict()
     digest = study.digest()
     if out.exists() and not out.is_dir():
         raise StudyError(f"--out {out} is a file, not a folder")
-    if out.exists() and any(out.iterdir()):
+    if out.exists() and any(out.iterdir()) and not _only_setup_leftovers(out):
         manifest = out / MANIFEST
         if not manifest.is_file():
             raise StudyError(f"--out {out} holds files that are not a study's results; give a new or empty folder")
+        from .results import _json
         try:
-            old = json.loads(manifest.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+            old = _json(manifest)
+        except StudyError:
             raise StudyError(f"--out {out}: its {MANIFEST} cannot be read; give a new or empty folder") from None
         if old.get("format") != FORMAT or old.get("study_sha256") != digest:
             raise StudyError(f"--out {out} holds the results of another study (or of another version of this one); "
                              "give a new folder to run this one")
+        if old.get("n_chunks") != study.n_chunks or old.get("n_cases") != study.n_cases or \
+                old.get("chunk_size") != study.chunk:
+            raise StudyError(f"--out {out}: its {MANIFEST} was changed (it says {old.get('n_chunks')} chunks of "
+                             f"{old.get('chunk_size')} cases, {old.get('n_cases')} cases; the study has "
+                             f"{study.n_chunks} of {study.chunk}, {study.n_cases}); give a new folder")
     else:
+        if out.exists():                           # an interrupted set-up: ours to clear
+            for e in out.iterdir():
+                if e.is_dir() and not e.is_symlink():
+                    shutil.rmtree(e)
+                else:
+                    e.unlink()
         out.mkdir(parents=True, exist_ok=True)
         (out / CHUNKS).mkdir(exist_ok=True)
         columns = ["case_id"] + [f.name for f in study.factors] + list(study.measures)
         manifest = {"format": FORMAT, "study_sha256": digest, "n_cases": study.n_cases, "chunk_size": study.chunk,
                     "n_chunks": study.n_chunks, "columns": columns, "seed": study.seed, "kind": study.kind}
-        for name, text in ((STUDY, json.dumps(doc, indent=1)), (MANIFEST, json.dumps(manifest, indent=1))):
-            tmp = out / f".{name}.tmp"
-            tmp.write_text(text, encoding="utf-8")
-            os.replace(tmp, out / name)
+        _write_json(out, STUDY, json.dumps(doc, indent=1))
+        _write_json(out, MANIFEST, json.dumps(manifest, indent=1))
     chunks = out / CHUNKS
     chunks.mkdir(exist_ok=True)
     for stale in chunks.glob(".chunk-*.tmp"):      # ours: a chunk an interrupted run left half-written
@@ -149,11 +225,29 @@ def run_study(study: Study, out, workers: int | None = None, scheduler: str | No
         raise StudyError("give --workers or --scheduler, not both")
     if workers is not None and not 1 <= workers <= 256:
         raise StudyError(f"--workers must be in [1, 256], got {workers}")
+    if scheduler is not None:               # before the folder is touched: one line if it does not answer
+        scheduler = check_scheduler_address(scheduler)
+        probe_scheduler(scheduler)
     chunks = _prepare(study, out)
     t0 = time.perf_counter()
-    todo = [k for k in range(study.n_chunks) if not (chunks / chunk_name(k)).is_file()]
     n = study.n_cases
     size = study.chunk
+    digest = study.digest()
+    todo, repaired = [], []
+    for k in range(study.n_chunks):
+        path = chunks / chunk_name(k)
+        if not (path.exists() or path.is_symlink()):
+            todo.append(k)
+            continue
+        if path.is_dir() and not path.is_symlink():
+            raise StudyError(f"--out {out}: {path} is a folder, not a chunk; give a new folder")
+        why = "is not a regular file" if path.is_symlink() or not path.is_file() else \
+            chunk_problem(path, digest, k, k * size, min(n, (k + 1) * size))
+        if why is not None:                 # ours, and wrong: computed again (a warning names it)
+            print(f"lcv study: warning: {path} {why}; it is computed again", file=sys.stderr)
+            path.unlink()
+            todo.append(k)
+            repaired.append(k)
     bounds = {k: (k * size, min(n, (k + 1) * size)) for k in todo}
     found = study.n_chunks - len(todo)
     done_cases = n - sum(b - a for a, b in bounds.values())
@@ -175,7 +269,7 @@ def run_study(study: Study, out, workers: int | None = None, scheduler: str | No
                 stale.unlink()
             except OSError:
                 pass
-    return RunSummary(out, study.n_chunks, len(todo), found, n, time.perf_counter() - t0)
+    return RunSummary(out, study.n_chunks, len(todo), found, n, time.perf_counter() - t0, len(repaired))
 
 
 #: the local cluster's workers: one BLAS thread; glibc's malloc told to keep freed memory
@@ -193,6 +287,67 @@ WORKER_CONFIG = {
 }
 
 
+#: how long a scheduler has to answer, from the TCP connect to its reply to "identity" [s]
+SCHEDULER_TIMEOUT_S = 10.0
+
+
+def check_scheduler_address(address: str) -> str:
+    """``address`` as Dask's comm layer reads it (``tcp://host:port``; a bare ``host:port`` is
+    TCP), or :class:`StudyError` naming it and the form expected."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+    form = "tcp://HOST:PORT (or tls://HOST:PORT) of a running Dask scheduler"
+    if not isinstance(address, str) or not address.strip() or not address.isprintable():
+        raise StudyError(f"--scheduler {address!r}: expected {form}")
+    try:
+        scheme, loc = parse_address(address)
+        host, port = parse_host_port(loc)
+    except (ValueError, TypeError) as exc:
+        raise StudyError(f"--scheduler {address}: expected {form} ({exc})") from None
+    if scheme not in ("tcp", "tls"):
+        raise StudyError(f"--scheduler {address}: the scheme {scheme!r} is not one lcv study connects through; "
+                         f"expected {form}")
+    if not host or not 0 < int(port) < 65536:
+        raise StudyError(f"--scheduler {address}: expected {form} (port in 1..65535)")
+    return f"{scheme}://{loc}"
+
+
+def probe_scheduler(address: str, timeout_s: float = SCHEDULER_TIMEOUT_S) -> dict:
+    """Ask the peer at ``address`` who it is, with one deadline for the whole exchange (a port
+    that accepts and never writes, or answers HTTP, is refused within ``timeout_s``).
+
+    Raises
+    ------
+    StudyError
+        Nothing listens there, the peer does not answer in time, or it is not a Dask scheduler.
+    """
+    import asyncio
+    from distributed.comm import connect
+
+    async def ask():
+        comm = await connect(address, timeout=timeout_s)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    async def bounded():
+        return await asyncio.wait_for(ask(), timeout_s)
+    try:
+        reply = asyncio.run(bounded())
+    except (asyncio.TimeoutError, TimeoutError):
+        raise StudyError(f"--scheduler {address}: no Dask scheduler answered there within {timeout_s:g} s") from None
+    except (OSError, EOFError) as exc:
+        raise StudyError(f"--scheduler {address}: no Dask scheduler answers there "
+                         f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'closed'})") from None
+    except Exception as exc:  # noqa: BLE001 - whatever a peer that is not a scheduler makes the comm raise
+        raise StudyError(f"--scheduler {address}: the peer there is not a Dask scheduler "
+                         f"({type(exc).__name__})") from None
+    if not isinstance(reply, dict) or reply.get("type") != "Scheduler":
+        raise StudyError(f"--scheduler {address}: the peer there is not a Dask scheduler")
+    return reply
+
+
 def _run_distributed(study, todo, bounds, chunks, workers, scheduler, bar) -> None:
     import logging
     from dask.distributed import Client, LocalCluster, as_completed
@@ -202,8 +357,8 @@ def _run_distributed(study, todo, bounds, chunks, workers, scheduler, bar) -> No
     try:
         if scheduler is not None:
             try:
-                client = Client(scheduler, timeout="10s")
-            except OSError as exc:
+                client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S:g}s")
+            except (OSError, TimeoutError) as exc:
                 raise StudyError(f"--scheduler {scheduler}: no Dask scheduler answers there ({exc})") from None
         else:
             import dask

@@ -47,7 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.vehicle import Vehicle
+from ..model.vehicle import Vehicle, VehicleError
 from ..model.vehicle_file import dumps_vehicle, load_vehicle, loads_vehicle
 from ..ranges import RANGES, RangeError
 from ..units import kph_to_mps
@@ -176,6 +176,51 @@ class Study:
                     raise StudyError(f"factors.{f.name}: case {case} draws {draws[bad[0]]:.6g}; every value must be "
                                      f"{valid} (narrow the distribution)")
 
+    def check_cases(self) -> None:
+        """Refuse a study any of whose cases is outside the ranges table -- a speed, a tire
+        scale, a residual source, or a unit's mass or inertia or an axle's tire coefficient
+        after its scale factors -- naming the factor, the first such case and the range;
+        block by block (:data:`DRAW_BLOCK` cases), in constant memory, before anything is
+        computed (a model far outside the ranges gives numbers that mean nothing)."""
+        from ..ranges import VEHICLE
+        n = self.n_cases
+        if not self.factors:
+            return
+        for start in range(0, n, DRAW_BLOCK):
+            ids = np.arange(start, min(n, start + DRAW_BLOCK))
+            table = self.factor_table(ids)
+            speeds = self.speeds_mps(table)
+            r = RANGES["speed"]
+            bad = np.flatnonzero(~((speeds >= r.low) & (speeds <= r.high)))
+            if bad.size:
+                name = "speed_mps" if "speed_mps" in table else "speed_kph"
+                value = table[name][bad[0]] if name in table else self.speed_kph
+                raise StudyError(f"factors.{name}: case {int(ids[bad[0]])} has {value:.6g}; a speed must be in "
+                                 f"{r.text()} ({r.text(3.6, 'km/h')})")
+            for name, arr in table.items():
+                key = "tire_scale" if name == "tire_scale" else residual_key(name)
+                if key is None:
+                    continue
+                vals = np.asarray(arr, dtype=float)
+                r = RANGES[key]
+                ok = (vals > r.low) if r.low_open else (vals >= r.low)
+                bad = np.flatnonzero(~(ok & (vals <= r.high)))
+                if bad.size:
+                    raise StudyError(f"factors.{name}: case {int(ids[bad[0]])} has {vals[bad[0]]:.6g}; it must be in "
+                                     f"{r.text()} ({r.description})")
+            for pname, vals in self.batch_parameters(table).items():
+                owner, key = pname.split(".", 1)
+                r = VEHICLE[key]
+                vals = np.asarray(vals, dtype=float)
+                ok = (vals > r.low) if r.low_open else (vals >= r.low)
+                bad = np.flatnonzero(~(ok & (vals <= r.high) & np.isfinite(vals)))
+                if bad.size:
+                    k = int(bad[0])
+                    used = [f.name for f in self.factors if f.name in table and _scales(self.vehicle, f.name, pname)]
+                    given = ", ".join(f"{f} = {float(table[f][k]):.6g}" for f in used)
+                    raise StudyError(f"factors.{used[0] if used else pname}: case {int(ids[k])} makes {pname} "
+                                     f"{vals[k]:.6g} {r.unit} ({given}); {key} must be in {r.text()}")
+
     def factor_table(self, case_ids) -> dict:
         """Every factor's value for the cases ``case_ids``: name -> array (file order)."""
         ids = np.asarray(list(case_ids) if not isinstance(case_ids, np.ndarray) else case_ids, dtype=np.int64)
@@ -269,6 +314,20 @@ class Study:
 
     def digest(self) -> str:
         return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()
+
+
+def _scales(vehicle: Vehicle, factor: str, pname: str) -> bool:
+    """True when the factor ``factor`` scales the parameter ``pname`` (``owner.key``)."""
+    if "." not in factor:
+        return False
+    owner, key = factor.split(".", 1)
+    powner, pkey = pname.split(".", 1)
+    if UNIT_SCALES.get(key) == pkey:
+        return owner == powner
+    if AXLE_SCALES.get(key) == pkey:
+        unit = next((u for u in vehicle.units if u.name == owner), None)
+        return owner == powner or (unit is not None and any(a.name == powner for a in unit.axles))
+    return False
 
 
 def _value_array(f: Factor) -> np.ndarray:
@@ -385,9 +444,12 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
         vehicle = load_preset(name)
     else:
         path = (base or Path.cwd()) / name
-        if not path.is_file():
+        if not path.exists():
             raise StudyError(f"vehicle: {name!r} is neither a preset ({', '.join(PRESETS)}) nor a file ({path})")
-        vehicle = load_vehicle(path)
+        try:
+            vehicle = load_vehicle(path)
+        except VehicleError as exc:
+            raise StudyError(f"vehicle {name!r}: {exc}") from None
     measures = doc.get("measures", list(DEFAULT_MEASURES))
     if not isinstance(measures, list) or not measures or any(m not in MEASURES for m in measures) or \
             len(set(measures)) != len(measures):
@@ -438,19 +500,21 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
         raise StudyError(f"the design has {study.n_cases} cases; at most {MAX_CASES}")
     if kind == "random":
         study.check_draws()         # refuses non-positive draws now, not in a worker
+    study.check_cases()             # every case inside the ranges table, before anything is computed
     return study
 
 
 def load_study(path) -> Study:
     """Read and check a study file (TOML)."""
+    from ..util.files import FileInputError, read_text_file
     path = Path(path)
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise StudyError(f"study file {path} does not exist") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise StudyError(f"study file {path} cannot be read: {exc}") from None
+        doc = tomllib.loads(read_text_file(path, "study file"))
+    except FileInputError as exc:
+        raise StudyError(str(exc)) from None
     except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"study file {path} is not valid TOML: {exc}") from None
+    except ValueError as exc:          # an integer beyond Python's digit limit
         raise StudyError(f"study file {path} is not valid TOML: {exc}") from None
     return study_from_dict(doc, path.parent)
 
