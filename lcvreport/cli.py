@@ -310,7 +310,7 @@ def _vehicle(args: argparse.Namespace):
         raise UsageError(f"argument --vehicle {args.vehicle}: {exc}") from None
     from .model.plausibility import plausibility_warnings
     for line in plausibility_warnings(v):
-        print(f"lcv: warning: {args.vehicle}: {line}", file=sys.stderr)
+        print(f"lcv: warning: {_line(args.vehicle)}: {_line(line)}", file=sys.stderr)
     return v
 
 
@@ -519,7 +519,7 @@ def _cmd_steady(args, out: _Out) -> int:
 
 
 def _cmd_simulate(args, out: _Out) -> int:
-    from .analysis.exact import ManoeuvreError, final_state, response
+    from .analysis.exact import ManoeuvreError, check_lane_change_steer, final_state, response
     from .analysis.manoeuvres import SteerError, parse_steer, step
     v = _vehicle(args)
     steps_f = args.t_end / args.dt
@@ -553,6 +553,7 @@ def _cmd_simulate(args, out: _Out) -> int:
         t_b = (k + n) * args.dt
         try:
             r = response(v, u, steer, t_b, args.dt, F, args.tire_scale, t_start=k * args.dt, state=state)
+            check_lane_change_steer(r)      # a computed steer beyond [-1, 1] rad: refused before a row is written
         except ManoeuvreError as exc:
             raise UsageError(f"argument --steer: {exc}") from None
         M = r.matrix()
@@ -790,6 +791,8 @@ def _cmd_tracking(args, out: _Out) -> int:
         raise UsageError(f"argument {exc}") from None
     if not 1 <= args.draws <= 10_000_000:
         raise UsageError(f"argument --draws: must be in [1, 1e7], got {args.draws}")
+    if not 0 <= args.seed < 2 ** 63:
+        raise UsageError(f"argument --seed: must be in [0, 2^63), got {args.seed}")
     for opt, val in (("--lane-width-m", args.lane_width_m), ("--body-width-m", args.body_width_m)):
         if not (math.isfinite(val) and 0 < val <= 10):
             raise UsageError(f"argument {opt}: must be in (0, 10] m, got {val:g}")
@@ -801,7 +804,8 @@ def _cmd_tracking(args, out: _Out) -> int:
                            dists["conicity_moment"], dists["ply_steer_moment"], axles, args.lane_width_m,
                            args.body_width_m, args.draws, args.seed, F, args.tire_scale)
     except TrackingError as exc:
-        raise UsageError(f"argument: {exc}") from None
+        opt = " --axles" if "axle" in str(exc).split(";")[0] and args.axles else ""
+        raise UsageError(f"argument{opt}: {exc}") from None
     doc = s.to_dict()
     if args.json:
         out.json(doc)
@@ -909,17 +913,10 @@ def _cmd_study(args, out: _Out) -> int:
         for f in study.factors:
             out.line(f"  {f.describe()}")
         out.stream.flush()
-    import signal
-
-    def _terminated(_signum, _frame):     # a batch system's SIGTERM ends a study as Ctrl-C does
-        raise KeyboardInterrupt
-    previous = signal.signal(signal.SIGTERM, _terminated)
     try:
         summary = run_study(study, out_dir, workers=args.workers, scheduler=args.scheduler)
     except StudyError as exc:
         raise UsageError(str(exc)) from None
-    finally:
-        signal.signal(signal.SIGTERM, previous)
     if args.csv:
         from .study.results import read_study
         tmp = out_dir / ".results.csv.tmp"
@@ -964,12 +961,25 @@ COMMANDS = {"presets": _cmd_presets, "eig": _cmd_eig, "matrices": _cmd_matrices,
             "tracking": _cmd_tracking, "turn": _cmd_turn, "study": _cmd_study}
 
 
+def _line(text) -> str:
+    """``text`` as one line of plain text: every character that is not printable (a newline, an
+    ESC that would drive the terminal) escaped, so a message quoting a user's file is one line."""
+    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(text))
+
+
 def run(argv: Sequence[str] | None = None, out=None) -> int:
     """Run ``lcv`` with ``argv``; return the exit status.  Output goes to ``out`` (stdout)."""
+    import signal
+    import threading
     stream = out if out is not None else sys.stdout
+    previous = None
     try:
         args = build_parser().parse_args(argv)
         writer = _Out(stream)
+        if threading.current_thread() is threading.main_thread():
+            # a batch system's SIGTERM (a time limit) ends any command as Ctrl-C does: what it was
+            # writing aside is removed, nothing half-written is left
+            previous = signal.signal(signal.SIGTERM, _terminated)
         status = COMMANDS[args.command](args, writer)
         stream.flush()
         return status
@@ -977,30 +987,37 @@ def run(argv: Sequence[str] | None = None, out=None) -> int:
         print("lcv: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except UsageError as exc:
-        print(f"lcv: error: {exc}", file=sys.stderr)
+        print(f"lcv: error: {_line(exc)}", file=sys.stderr)
         return 2
     except (RangeError, KeyError) as exc:
-        print(f"lcv: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
+        print(f"lcv: error: {_line(exc.args[0] if exc.args else exc)}", file=sys.stderr)
         return 2
     except BrokenPipeError:
         _silence_stdout()
         return EXIT_BROKEN_PIPE
     except OutputError as exc:
-        print(f"lcv: error: {exc}", file=sys.stderr)
+        print(f"lcv: error: {_line(exc)}", file=sys.stderr)
         return 1
     except OSError as exc:
         if exc.errno == errno.EPIPE:
             _silence_stdout()
             return EXIT_BROKEN_PIPE
-        print(f"lcv: error: cannot write the output: {exc.strerror or exc}", file=sys.stderr)
+        print(f"lcv: error: cannot write the output: {_line(exc.strerror or exc)}", file=sys.stderr)
         _silence_stdout()
         return 1
     except FloatingPointError as exc:
-        print(f"lcv: error: {exc}", file=sys.stderr)
+        print(f"lcv: error: {_line(exc)}", file=sys.stderr)
         return 1
     except Exception as exc:  # noqa: BLE001 - one line, never a traceback
-        print(f"lcv: internal error: {type(exc).__name__}: {exc} (please report this)", file=sys.stderr)
+        print(f"lcv: internal error: {type(exc).__name__}: {_line(exc)} (please report this)", file=sys.stderr)
         return 1
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _terminated(_signum, _frame):
+    raise KeyboardInterrupt
 
 
 def _silence_stdout() -> None:

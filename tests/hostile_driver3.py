@@ -57,8 +57,13 @@ def main():
                  ctypes.c_bool, ctypes.c_bool, ctypes.c_bool, V, ctypes.c_size_t, V, LOG, V)
     resources = (os.path.join(d, "resources") + "/").encode()
 
-    def instantiate(token=token, resources=resources, event=False):
-        return inst_cs(b"h", token, resources, False, logging, event, False, None, 0, None, log, None)
+    def instantiate(token=token, resources=resources, event=False, name=b"h"):
+        return inst_cs(name, token, resources, False, logging, event, False, None, 0, None, log, None)
+
+    def instantiate_me():
+        me = fn("fmi3InstantiateModelExchange", V, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_bool,
+                ctypes.c_bool, V, LOG)
+        return me(b"h", token, resources, False, logging, None, log)
 
     U = ctypes.c_uint
     D = ctypes.c_double
@@ -106,6 +111,56 @@ def main():
             call("fmi3EnterInitializationMode", [V, B, D, D, B, D], c, False, 0.0, 0.0, False, 0.0)
             call("fmi3ExitInitializationMode", [V], c)
             call("fmi3DoStep", [V, D, D, B, V, V, V, V], c, 0.0, 0.01, True, None, None, None, None)
+    elif case == "instance_name_not_utf8":
+        c = instantiate(name=b"Fahrzeug \xfcber \xff\xfe")
+        statuses.append(0 if c else 3)
+        if c:
+            init(c)
+            step(c)
+            read(c)
+    elif case == "me_state_round_trip":    # the native FMU's Model Exchange instance keeps its FMU state
+        c = instantiate_me()
+        assert c, records
+        n = S()
+        fn("fmi3GetNumberOfContinuousStates", ctypes.c_int, V, V)(c, ctypes.byref(n))
+        nx = n.value
+        init(c)                                                            # 0, 0
+        call("fmi3EnterContinuousTimeMode", [V], c)                        # 0
+        x = arr(D, *[0.001 * (k + 1) for k in range(nx)])
+        call("fmi3SetContinuousStates", [V, V, S], c, x, nx)               # 0
+        call("fmi3SetTime", [V, D], c, 0.5)                                # 0
+        state = V()
+        call("fmi3GetFMUState", [V, V], c, ctypes.byref(state))            # 0
+        call("fmi3SetContinuousStates", [V, V, S], c, arr(D, *[0.0] * nx), nx)   # 0
+        call("fmi3SetTime", [V, D], c, 0.9)                                # 0
+        call("fmi3SetFMUState", [V, V], c, state)                          # 0
+        back = arr(D, *[0.0] * nx)
+        call("fmi3GetContinuousStates", [V, V, S], c, back, nx)            # 0
+        t = arr(D, 0.0)
+        call("fmi3GetFloat64", [V, V, S, V, S], c, arr(U, vr["time"]), 1, t, 1)   # 0
+        records.append((0, f"restored={list(back[:nx]) == list(x[:nx]) and t[0] == 0.5}"))
+        call("fmi3FreeFMUState", [V, V], c, ctypes.byref(state))           # 0
+    elif case == "cs_state_into_me":       # an FMU state of the other interface is refused
+        cs = instantiate()
+        assert cs, records
+        init(cs)                                                           # 0, 0
+        step(cs)                                                           # 0
+        state = V()
+        call("fmi3GetFMUState", [V, V], cs, ctypes.byref(state))           # 0
+        c = instantiate_me()
+        assert c, records
+        init(c)                                                            # 0, 0
+        call("fmi3SetFMUState", [V, V], c, state)                          # E: a Co-Simulation's state
+        call("fmi3DoStep", [V, D, D, B, V, V, V, V], c, 0.0, 0.01, True, None, None, None, None)  # E
+        call("fmi3FreeFMUState", [V, V], cs, ctypes.byref(state))          # 0
+        free(cs)
+    elif case == "event_mode_twice":       # Model Exchange: Event Mode is entered from Continuous-Time Mode
+        c = instantiate_me()
+        assert c, records
+        init(c)                                                            # 0, 0 (now in Event Mode)
+        call("fmi3EnterEventMode", [V], c)                                 # E: already in Event Mode
+        call("fmi3EnterContinuousTimeMode", [V], c)                        # 0
+        call("fmi3EnterEventMode", [V], c)                                 # 0
     elif case == "model_exchange_calls":   # the native FMU's Model Exchange entry points
         me = fn("fmi3InstantiateModelExchange", V, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_bool,
                 ctypes.c_bool, V, LOG)
@@ -217,6 +272,85 @@ def main():
                  arr(D, 0), 1)
             step(c)
             read(c)
+        elif case == "start_time_not_finite":
+            call("fmi3EnterInitializationMode", [V, B, D, D, B, D], c, False, 0.0, float("nan"), False, 0.0)
+            call("fmi3EnterInitializationMode", [V, B, D, D, B, D], c, False, 0.0, float("inf"), False, 0.0)
+            init(c)
+            step(c)
+            t = arr(D, 0.0)
+            call("fmi3GetFloat64", [V, V, S, V, S], c, arr(U, vr["time"]), 1, t, 1)
+            finite[0] = finite[0] and math.isfinite(t[0])
+        elif case == "communication_point_not_finite":
+            init(c)
+            b1, b2, b3, last = B(), B(), B(), D()
+            for cp in (float("nan"), float("inf")):
+                call("fmi3DoStep", [V, D, D, B, V, V, V, V], c, cp, 0.01, True, ctypes.byref(b1), ctypes.byref(b2),
+                     ctypes.byref(b3), ctypes.byref(last))
+                finite[0] = finite[0] and math.isfinite(last.value)
+            step(c)
+            t = arr(D, 0.0)
+            call("fmi3GetFloat64", [V, V, S, V, S], c, arr(U, vr["time"]), 1, t, 1)
+            finite[0] = finite[0] and math.isfinite(t[0])
+            read(c)
+        elif case == "set_state_restores_time":
+            init(c)
+            b1, b2, b3, last = B(), B(), B(), D()
+
+            def step_at(t0):
+                return call("fmi3DoStep", [V, D, D, B, V, V, V, V], c, t0, 0.01, True, ctypes.byref(b1),
+                            ctypes.byref(b2), ctypes.byref(b3), ctypes.byref(last))
+
+            def now():
+                t = arr(D, 0.0)
+                call("fmi3GetFloat64", [V, V, S, V, S], c, arr(U, vr["time"]), 1, t, 1)
+                return t[0]
+            step_at(0.0)
+            step_at(0.01)
+            state = V()
+            call("fmi3GetFMUState", [V, V], c, ctypes.byref(state))
+            size = S()
+            call("fmi3SerializedFMUStateSize", [V, V, V], c, state, ctypes.byref(size))
+            buf = (ctypes.c_uint8 * size.value)()
+            call("fmi3SerializeFMUState", [V, V, V, S], c, state, buf, size.value)
+            for k in range(3):
+                step_at(0.02 + 0.01 * k)
+            at_end = now()
+            call("fmi3SetFMUState", [V, V], c, state)
+            restored = now()
+            for k in range(2):
+                step_at(0.02 + 0.01 * k)
+            other = V()
+            call("fmi3DeserializeFMUState", [V, V, S, V], c, buf, size.value, ctypes.byref(other))
+            call("fmi3SetFMUState", [V, V], c, other)
+            deserialized = now()
+            call("fmi3FreeFMUState", [V, V], c, ctypes.byref(state))
+            call("fmi3FreeFMUState", [V, V], c, ctypes.byref(other))
+            records.append((0, f"times={[round(at_end, 12), round(restored, 12), round(deserialized, 12)]}"))
+        elif case == "step_mode_calls":
+            init(c)
+            flags = [B() for _ in range(5)]
+            t_next = D()
+            call("fmi3UpdateDiscreteStates", [V, V, V, V, V, V, V], c, *[ctypes.byref(f) for f in flags],
+                 ctypes.byref(t_next))
+            call("fmi3EnterStepMode", [V], c)
+            step(c)
+        elif case == "directional_in_init":
+            call("fmi3EnterInitializationMode", [V, B, D, D, B, D], c, False, 0.0, 0.0, False, 0.0)
+            dd = [V, V, S, V, S, V, S, V, S]
+            out = arr(D, 0.0)
+            call("fmi3GetDirectionalDerivative", dd, c, arr(U, vr["r1"]), 1, arr(U, vr["u"]), 1, arr(D, 1.0), 1, out, 1)
+            call("fmi3GetDirectionalDerivative", dd, c, arr(U, vr["max_real_eig"]), 1, arr(U, vr["delta"]), 1,
+                 arr(D, 1.0), 1, out, 1)
+            call("fmi3GetDirectionalDerivative", dd, c, arr(U, 99999), 1, arr(U, vr["delta"]), 1, arr(D, 1.0), 1,
+                 out, 1)
+            call("fmi3GetDirectionalDerivative", dd, c, arr(U, vr["r1"]), 1, arr(U, vr["delta"]), 1, arr(D, 1.0), 1,
+                 out, 1)
+        elif case == "clamped_step_status":
+            call("fmi3SetFloat64", [V, V, S, V, S], c, arr(U, vr["u"]), 1, arr(D, 0.5), 1)
+            init(c)
+            step(c)                         # Warning: u below u_min, clamped (both FMUs the same)
+            step(c)                         # 0: the warning is given once
+            read(c)
         elif case == "terminate_then_step":
             init(c)
             call("fmi3Terminate", [V], c)
@@ -239,7 +373,8 @@ def main():
         free(c)
     after = {"path": list(sys.path), "meta": [repr(f) for f in sys.meta_path]}
     changed = {k: [x for x in after[k] if x not in before[k]] for k in before}
-    print(json.dumps({"status": statuses, "messages": [m for s, m in records if s in (1, 3, 4) or m.startswith("r1=")],
+    print(json.dumps({"status": statuses, "messages": [m for s, m in records if s in (1, 3, 4) or
+                                                       m.startswith(("r1=", "times=", "restored="))],
                       "fatal": any(s == 4 for s, _m in records) or 4 in statuses, "finite": finite[0],
                       "changed": changed}))
     print("survived")

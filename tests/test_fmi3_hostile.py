@@ -40,6 +40,14 @@ CASES = {
     "state_round_trip": ([0] * 13, None),
     "events_and_clocks": ([0, 0, E, ANY, E, E, E, E, E, 0, 0], None),
     "terminate_then_step": ([0, 0, 0, E, 0, 0, 0, 0, 0], "must not be called in phase Terminated"),
+    # issue 28 (round four): time that is not a number, the time an FMU state keeps, calls of Event
+    # Mode in Step Mode, derivatives the README says are refused, one status for a clamped step
+    "start_time_not_finite": ([E, E, 0, 0, 0, 0], "startTime is not finite"),
+    "communication_point_not_finite": ([0, 0, E, E, 0, 0, 0], "currentCommunicationPoint is not finite"),
+    "set_state_restores_time": ([0] * 20, "times=[0.05, 0.02, 0.02]"),
+    "step_mode_calls": ([0, 0, E, E, 0], None),
+    "directional_in_init": ([0, E, E, E, 0], "not a continuous state or an input other than u"),
+    "clamped_step_status": ([0, 0, 0, 1, 0, 0], "is below u_min"),
 }
 # what only one of the two does (the native FMU has Model Exchange and needs no resources)
 PER_KIND = {
@@ -47,10 +55,16 @@ PER_KIND = {
                "null_resources": ([E], "resourcePath is NULL"),
                "event_mode": ([E], "has no event mode"),
                "model_exchange_of_cs_only": ([E], "is a Co-Simulation FMU"),
-               "deserialize_garbage": ([0, 0, E, E, E, 0], "not an FMU state written by this FMU")},
+               "deserialize_garbage": ([0, 0, E, E, E, 0], "not an FMU state written by this FMU"),
+               "instance_name_not_utf8": ([E], "the instanceName is not UTF-8 text"),
+               "directional_in_init": ([0, E, E, E, E], None)},      # it provides no directional derivative
     "native": {"model_exchange_of_cs_only": ([0, 0, 0, E], None),
                "model_exchange_calls": ([0, 0, 0, 0, 0, E, E, E, E, E, E, 0, E, 0, 0, 0], "states given, this FMU has 14"),
-               "deserialize_garbage": ([0, 0, E, E, E, 0], "serialized FMU state of 1024 bytes: expected")},
+               "deserialize_garbage": ([0, 0, E, E, E, 0], "serialized FMU state of 1024 bytes: expected"),
+               "instance_name_not_utf8": ([0, 0, 0, 0, 0], None),   # the name is only copied and logged
+               "me_state_round_trip": ([0] * 12, "restored=True"),
+               "cs_state_into_me": ([0, 0, 0, 0, 0, 0, E, E, 0], "written by a Co-Simulation instance"),
+               "event_mode_twice": ([0, 0, E, 0, 0], "must not be called in phase")},
 }
 
 

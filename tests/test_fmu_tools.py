@@ -193,7 +193,7 @@ def test_c_fmu_in_a_c_host_gives_exactly_what_fmpy_gives(c_host, native_fmu, tmp
         t += h
     p = run_host(c_host, unz, "LCVNative", "\n".join(lines) + "\n")
     assert p.returncode == 0 and p.stdout.rstrip().endswith("done"), p.stderr
-    assert set(host_statuses(p.stdout)) == {0}
+    assert set(host_statuses(p.stdout)) == {0, 1}        # fmi2Warning where u first falls below u_min (clamp)
     s = Slave(native_fmu, preset="legal_max").init()
     ref = run_schedule(s, steps)
     s.free()

@@ -310,7 +310,7 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real currentCommunicationPoint, fm
         return fmi2Error;
     }
     if (r > 0) logmsg(c, fmi2Warning, "%s", c->msg);
-    return fmi2OK;
+    return r > 0 ? fmi2Warning : fmi2OK;    /* a clamped speed: the Python FMU's status too */
 }
 
 fmi2Status fmi2CancelStep(fmi2Component comp)
@@ -368,7 +368,7 @@ fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx)
     int r = model_derivatives(c, dx, nx);
     if (r < 0) { logmsg(c, fmi2Error, "%s", c->msg); return fmi2Error; }
     if (r > 0) logmsg(c, fmi2Warning, "%s", c->msg);
-    return fmi2OK;
+    return r > 0 ? fmi2Warning : fmi2OK;
 }
 
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real x_nominal[], size_t nx)

@@ -170,7 +170,7 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)
 
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
-    BEGIN(fmi3EnterEventMode, PhaseEventMode | PhaseContinuousTimeMode)
+    BEGIN(fmi3EnterEventMode, PhaseContinuousTimeMode)      /* from Continuous-Time Mode (Model Exchange) only */
     c->m.s.phase = PhaseEventMode;
     return fmi3OK;
 }
@@ -595,7 +595,7 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
                                     fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
                                     fmi3Float64 *nextEventTime)
 {
-    BEGIN(fmi3UpdateDiscreteStates, PhaseEventMode | PhaseStepComplete)
+    BEGIN(fmi3UpdateDiscreteStates, PhaseEventMode)         /* Event Mode only (Co-Simulation has none here) */
     if (!discreteStatesNeedUpdate || !terminateSimulation || !nominalsOfContinuousStatesChanged ||
         !valuesOfContinuousStatesChanged || !nextEventTimeDefined || !nextEventTime) {
         logmsg(c, fmi3Error, "fmi3UpdateDiscreteStates: null pointer");
@@ -688,7 +688,7 @@ fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 
     int r = model_derivatives(&c->m, derivatives, nContinuousStates);
     if (r < 0) { logmsg(c, fmi3Error, "%s", c->m.msg); return fmi3Error; }
     if (r > 0) logmsg(c, fmi3Warning, "%s", c->m.msg);
-    return fmi3OK;
+    return r > 0 ? fmi3Warning : fmi3OK;
 }
 
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nContinuousStates)
@@ -731,7 +731,7 @@ fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *nConti
 /* ------------------------------------------------------------------ Co-Simulation */
 fmi3Status fmi3EnterStepMode(fmi3Instance instance)
 {
-    BEGIN(fmi3EnterStepMode, PhaseEventMode | PhaseStepComplete)
+    BEGIN(fmi3EnterStepMode, PhaseEventMode)                /* leaves a Co-Simulation's Event Mode: never used here */
     if (c->m.model_exchange) { logmsg(c, fmi3Error, "fmi3EnterStepMode: the instance is a model exchange"); return fmi3Error; }
     c->m.s.phase = PhaseStepComplete;
     return fmi3OK;
@@ -765,9 +765,13 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
         return fmi3Error;
     }
     if (!allowed(c, "fmi3DoStep", PhaseStepComplete)) return fmi3Error;
+    if (!isfinite(currentCommunicationPoint)) {
+        logmsg(c, fmi3Error, "fmi3DoStep: currentCommunicationPoint is not finite (%g)", currentCommunicationPoint);
+        return fmi3Error;
+    }
     int r = model_do_step(&c->m, communicationStepSize);
     if (r < 0) { logmsg(c, fmi3Error, "%s", c->m.msg); return fmi3Error; }
     if (r > 0) logmsg(c, fmi3Warning, "%s", c->m.msg);
     *lastSuccessfulTime = c->m.s.time;
-    return fmi3OK;
+    return r > 0 ? fmi3Warning : fmi3OK;    /* a clamped speed: the Python FMU's status too */
 }

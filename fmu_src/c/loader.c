@@ -112,6 +112,7 @@ typedef struct {
     int phase;
     char *name;
     char *folder;                         /* the resources folder (taken off sys.path at the last free) */
+    char *alias;                          /* a symlink to it pythonfmu reads as is, or NULL (pyruntime.h) */
 } Wrapper;
 
 /* an FMU state: pythonfmu's and the phase */
@@ -174,10 +175,6 @@ static int resource_folder(const char *uri, char *out, size_t size, char *why, s
     if (!pyrt_valid_utf8((const unsigned char *)out)) {
         snprintf(why, wsize, "the resource folder of %.1000s is not UTF-8 text; unzip the FMU under a folder whose "
                  "name is", uri);
-        return 0;
-    }
-    if (strstr(out, "%20")) {   /* pythonfmu would turn it into a space */
-        snprintf(why, wsize, "the resource folder %.1000s has \"%%20\" in its name; unzip the FMU elsewhere", out);
         return 0;
     }
     char module[4200];
@@ -291,6 +288,12 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 {
     if (!functions || !functions->logger) return NULL;
     const char *name = instanceName ? instanceName : LOADER_MODEL_IDENTIFIER;
+    if (!pyrt_valid_utf8((const unsigned char *)name)) {
+        /* pythonfmu decodes the name as UTF-8 and takes the host down on a failure */
+        say_once(functions, LOADER_MODEL_IDENTIFIER, "fmi2Instantiate: the instanceName is not UTF-8 text; "
+                 "give a name of UTF-8 text");
+        return NULL;
+    }
     if (!fmuGUID || strcmp(fmuGUID, LOADER_GUID) != 0) {
         say_once(functions, name, "guid mismatch: the modelDescription.xml does not belong to this binary");
         return NULL;
@@ -309,16 +312,24 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         say_once(functions, name, load_error);
         return NULL;
     }
+    char alias[128] = "";
+    if (pyrt_needs_alias(folder) && !pyrt_resource_alias(folder, alias, sizeof alias, why, sizeof why)) {
+        say_once(functions, name, why);
+        return NULL;
+    }
+    const char *given = *alias ? alias : folder;
     Wrapper *w = (Wrapper *)calloc(1, sizeof(Wrapper));
-    char *uri = (char *)malloc(strlen(folder) + 8);
-    if (!w || !uri || !(w->name = strdup(name)) || !(w->folder = strdup(folder))) {
+    char *uri = (char *)malloc(strlen(given) + 8);
+    if (!w || !uri || !(w->name = strdup(name)) || !(w->folder = strdup(folder)) ||
+        (*alias && !(w->alias = strdup(alias)))) {
         if (w) { free(w->name); free(w->folder); }
         free(w);
         free(uri);
+        pyrt_resource_alias_free(alias);
         say_once(functions, name, "out of memory");
         return NULL;
     }
-    sprintf(uri, "file://%s", folder);
+    sprintf(uri, "file://%s", given);
     memcpy((void *)&w->host, functions, sizeof *functions);
     fmi2CallbackFunctions own = {own_logger, functions->allocateMemory ? functions->allocateMemory : calloc,
                                  functions->freeMemory ? functions->freeMemory : free, NULL, w};
@@ -342,8 +353,10 @@ void fmi2FreeInstance(fmi2Component c)
     if (!w) return;
     if (w->inner && !w->dead) p_fmi2FreeInstance(w->inner);
     pyrt_instance_freed(w->folder);
+    pyrt_resource_alias_free(w->alias);
     free(w->name);
     free(w->folder);
+    free(w->alias);
     free(w);
 }
 

@@ -19,6 +19,7 @@
  */
 #define _POSIX_C_SOURCE 200809L   /* strdup */
 #include <dlfcn.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -73,14 +74,18 @@ typedef struct {
     double time;                          /* the independent variable: the start, then each step's end */
     char *name;
     char *folder;
+    char *alias;                          /* a symlink to it pythonfmu3 reads as is, or NULL (pyruntime.h) */
 } Wrapper;
 
 #define LOADER_STATE_TAG 0x4C435633U      /* "LCV3" */
 typedef struct {
     unsigned tag;
     int phase;
+    double time;                          /* the independent variable, which the loader keeps */
     fmi3FMUState inner;
 } LoaderState;
+/* a serialized state: pythonfmu3's bytes, the time (8 bytes), the phase (one digit) */
+#define LOADER_STATE_TRAILER (sizeof(double) + 1)
 
 /* ------------------------------------------------------------------ logging */
 static void say(Wrapper *w, fmi3Status status, const char *fmt, ...)
@@ -188,6 +193,12 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     (void)earlyReturnAllowed; (void)requiredIntermediateVariables; (void)intermediateUpdate;
     char why[2400];
     const char *name = instanceName ? instanceName : LOADER_MODEL_IDENTIFIER;
+    if (!pyrt_valid_utf8((const unsigned char *)name)) {
+        /* pythonfmu3 decodes the name as UTF-8 and takes the host down on a failure */
+        say_once(instanceEnvironment, logMessage, "fmi3InstantiateCoSimulation: the instanceName is not UTF-8 text; "
+                 "give a name of UTF-8 text");
+        return NULL;
+    }
     if (!instantiationToken || strcmp(instantiationToken, LOADER_GUID) != 0) {
         say_once(instanceEnvironment, logMessage,
                  "instantiation token mismatch: the modelDescription.xml does not belong to this binary");
@@ -211,10 +222,10 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     size_t j = strlen(folder);
     while (j > 1 && folder[j - 1] == '/') folder[--j] = '\0';
     snprintf(module, sizeof module, "%s/slavemodule.txt", folder);
-    if (folder[0] != '/' || !pyrt_valid_utf8((const unsigned char *)folder) || strstr(folder, "%20") ||
+    if (folder[0] != '/' || !pyrt_valid_utf8((const unsigned char *)folder) ||
         !pyrt_is_dir(folder) || !pyrt_is_file(module)) {
         snprintf(why, sizeof why, "the resourcePath %.1000s is not this FMU's resources folder (an absolute path "
-                 "of UTF-8 text, without \"%%20\", holding slavemodule.txt)", folder);
+                 "of UTF-8 text holding slavemodule.txt)", folder);
         say_once(instanceEnvironment, logMessage, why);
         return NULL;
     }
@@ -223,10 +234,16 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         say_once(instanceEnvironment, logMessage, load_error);
         return NULL;
     }
+    char alias[128] = "";
+    if (pyrt_needs_alias(folder) && !pyrt_resource_alias(folder, alias, sizeof alias, why, sizeof why)) {
+        say_once(instanceEnvironment, logMessage, why);
+        return NULL;
+    }
     Wrapper *w = (Wrapper *)calloc(1, sizeof(Wrapper));
-    if (!w || !(w->name = strdup(name)) || !(w->folder = strdup(folder))) {
+    if (!w || !(w->name = strdup(name)) || !(w->folder = strdup(folder)) || (*alias && !(w->alias = strdup(alias)))) {
         if (w) { free(w->name); free(w->folder); }
         free(w);
+        pyrt_resource_alias_free(alias);
         say_once(instanceEnvironment, logMessage, "out of memory");
         return NULL;
     }
@@ -236,7 +253,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     w->phase = PhaseInstantiated;
     pyrt_instance_added();
     /* logging on inside: the loader filters what the host sees */
-    w->inner = p_fmi3InstantiateCoSimulation(w->name, instantiationToken, folder, visible, fmi3True, fmi3False,
+    w->inner = p_fmi3InstantiateCoSimulation(w->name, instantiationToken, w->alias ? w->alias : folder, visible,
+                                             fmi3True, fmi3False,
                                              fmi3False, NULL, 0, w, own_logger, NULL);
     if (!w->inner) {
         say(w, fmi3Error, "fmi3InstantiateCoSimulation: the Python model could not be instantiated");
@@ -277,8 +295,10 @@ void fmi3FreeInstance(fmi3Instance instance)
     if (!w) return;
     if (w->inner && !w->dead) p_fmi3FreeInstance(w->inner);
     pyrt_instance_freed(w->folder);
+    pyrt_resource_alias_free(w->alias);
     free(w->name);
     free(w->folder);
+    free(w->alias);
     free(w);
 }
 
@@ -295,6 +315,10 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime)
 {
     BEGIN(fmi3EnterInitializationMode, PhaseInstantiated)
+    if (!isfinite(startTime)) {
+        say(w, fmi3Error, "fmi3EnterInitializationMode: startTime is not finite (%g)", startTime);
+        return fmi3Error;
+    }
     w->time = startTime;
     return transition(w, p_fmi3EnterInitializationMode(w->inner, toleranceDefined, tolerance, startTime,
                                                        stopTimeDefined, stopTime),
@@ -328,6 +352,12 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     BEGIN(fmi3DoStep, PhaseStepMode | PhaseError)     /* in Error the slave names the cause */
     if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
         say(w, fmi3Error, "fmi3DoStep: null pointer");
+        return fmi3Error;
+    }
+    if (!isfinite(currentCommunicationPoint)) {
+        *eventHandlingNeeded = *terminateSimulation = *earlyReturn = fmi3False;
+        *lastSuccessfulTime = w->time;
+        say(w, fmi3Error, "fmi3DoStep: currentCommunicationPoint is not finite (%g)", currentCommunicationPoint);
         return fmi3Error;
     }
     fmi3Boolean event = fmi3False, terminate = fmi3False, early = fmi3False;
@@ -715,6 +745,7 @@ fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
     fmi3Status r = outcome(w, p_fmi3GetFMUState(w->inner, &inner), "fmi3GetFMUState");
     s->inner = inner;
     s->phase = w->phase;
+    s->time = w->time;
     *FMUState = s;
     return r;
 }
@@ -726,7 +757,10 @@ fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
     LoaderState *s = own_state(w, FMUState, "fmi3SetFMUState");
     if (!s || !s->inner) return fmi3Error;
     fmi3Status r = outcome(w, p_fmi3SetFMUState(w->inner, s->inner), "fmi3SetFMUState");
-    if (r <= fmi3Warning) w->phase = s->phase;
+    if (r <= fmi3Warning) {
+        w->phase = s->phase;
+        w->time = s->time;
+    }
     return r;
 }
 
@@ -753,7 +787,7 @@ fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUSta
     if (!s || !s->inner) return fmi3Error;
     size_t inner = 0;
     fmi3Status r = outcome(w, p_fmi3SerializedFMUStateSize(w->inner, s->inner, &inner), "fmi3SerializedFMUStateSize");
-    *size = inner + 1;             /* one byte more: the phase */
+    *size = inner + LOADER_STATE_TRAILER;     /* more: the time and the phase */
     return r;
 }
 
@@ -765,15 +799,17 @@ fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, f
     LoaderState *s = own_state(w, FMUState, "fmi3SerializeFMUState");
     if (!s || !s->inner) return fmi3Error;
     size_t need = 0;
-    if (p_fmi3SerializedFMUStateSize(w->inner, s->inner, &need) != fmi3OK || need + 1 > size) {
-        say(w, fmi3Error, "fmi3SerializeFMUState: %u bytes given, %u needed", (unsigned)size, (unsigned)need + 1);
+    if (p_fmi3SerializedFMUStateSize(w->inner, s->inner, &need) != fmi3OK || need + LOADER_STATE_TRAILER > size) {
+        say(w, fmi3Error, "fmi3SerializeFMUState: %u bytes given, %u needed", (unsigned)size,
+            (unsigned)(need + LOADER_STATE_TRAILER));
         return fmi3Error;
     }
     fmi3Status r = outcome(w, p_fmi3SerializeFMUState(w->inner, s->inner, serializedState, need),
                            "fmi3SerializeFMUState");
+    memcpy(serializedState + need, &s->time, sizeof(double));
     int bit = 0;
     while (bit < 5 && (1 << bit) != s->phase) ++bit;
-    serializedState[need] = (fmi3Byte)('0' + bit);
+    serializedState[need + sizeof(double)] = (fmi3Byte)('0' + bit);
     return r;
 }
 
@@ -786,9 +822,11 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
         return fmi3Error;
     }
     size_t magic = strlen(LOADER_STATE_MAGIC);
-    if (size < magic + 1 || size > LOADER_STATE_MAX_BYTES ||
+    double time = 0.0;
+    if (size >= magic + LOADER_STATE_TRAILER) memcpy(&time, serializedState + size - LOADER_STATE_TRAILER, sizeof time);
+    if (size < magic + LOADER_STATE_TRAILER || size > LOADER_STATE_MAX_BYTES ||
         memcmp(serializedState, LOADER_STATE_MAGIC, magic) != 0 || serializedState[size - 1] < '0' ||
-        serializedState[size - 1] > '4') {
+        serializedState[size - 1] > '4' || !isfinite(time)) {
         say(w, fmi3Error, "fmi3DeserializeFMUState: %u bytes that are not an FMU state written by this FMU",
             (unsigned)size);
         return fmi3Error;
@@ -796,8 +834,8 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
     LoaderState *s = (LoaderState *)*FMUState;
     if (s && !own_state(w, s, "fmi3DeserializeFMUState")) return fmi3Error;
     fmi3FMUState inner = NULL;
-    fmi3Status r = outcome(w, p_fmi3DeserializeFMUState(w->inner, serializedState, size - 1, &inner),
-                           "fmi3DeserializeFMUState");
+    fmi3Status r = outcome(w, p_fmi3DeserializeFMUState(w->inner, serializedState, size - LOADER_STATE_TRAILER,
+                                                        &inner), "fmi3DeserializeFMUState");
     if (r > fmi3Warning) {
         if (inner) p_fmi3FreeFMUState(w->inner, &inner);
         return r;
@@ -814,6 +852,7 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
     s->tag = LOADER_STATE_TAG;
     s->inner = inner;
     s->phase = 1 << (serializedState[size - 1] - '0');
+    s->time = time;
     *FMUState = s;
     return r;
 }

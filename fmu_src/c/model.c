@@ -29,6 +29,7 @@ void model_reset(ModelInstance *c)
     c->s.last_speed = LCV_INPUT_START[0] > LCV_DEFAULT_U_MIN ? LCV_INPUT_START[0] : LCV_DEFAULT_U_MIN;
     c->s.phase = PhaseInstantiated;
     c->s.vehicle = -1;
+    c->s.model_exchange = c->model_exchange;
     for (int i = 0; i < LCV_N_STEP_CACHE; ++i) c->steps[i].valid = 0;
     for (int i = 0; i < LCV_N_SPEED_CACHE; ++i) c->speeds[i].valid = 0;
     c->clock = 0;
@@ -420,6 +421,32 @@ int model_directional(ModelInstance *c, const unsigned unknowns[], size_t nu, co
 {
     const LcvVehicle *v = vehicle_of(c);
     for (size_t i = 0; i < nu; ++i) out[i] = 0.0;
+    /* every value reference is checked first, in every phase the call is allowed in */
+    for (size_t i = 0; i < nk; ++i) {
+        unsigned r = knowns[i];
+        int ok = r >= LCV_FIRST_INPUT + 1 && r < LCV_FIRST_INPUT + LCV_N_INPUTS;
+        for (int j = 0; j < LCV_N_ME_STATES && !ok; ++j) ok = LCV_ME_STATE_VR[j] == r;
+        if (!ok) {
+            snprintf(c->msg, sizeof c->msg, "directional derivative: known %u (%s) is not a continuous state or an "
+                     "input other than u (the model is nonlinear in u)", r, model_variable_name(r));
+            return -1;
+        }
+    }
+    for (size_t i = 0; i < nu; ++i) {
+        unsigned r = unknowns[i];
+        if (r >= LCV_FIRST_DERIVATIVE && r < LCV_FIRST_DERIVATIVE + LCV_N_ME_STATES) continue;
+        if (!(r >= LCV_FIRST_OUTPUT && r < LCV_FIRST_OUTPUT + LCV_N_OUTPUTS)) {
+            snprintf(c->msg, sizeof c->msg, "directional derivative: unknown %u (%s) is not an output or a derivative",
+                     r, model_variable_name(r));
+            return -1;
+        }
+        int kind = LCV_OUTPUT_KIND[r - LCV_FIRST_OUTPUT];
+        if (kind != LCV_OUT_LINEAR && kind != LCV_OUT_LATERAL && kind != LCV_OUT_ACCEL) {
+            snprintf(c->msg, sizeof c->msg, "directional derivative: %s is not differentiable (the largest real part "
+                     "of the eigenvalues)", model_variable_name(r));
+            return -1;
+        }
+    }
     if (!v) return 0;                                  /* before initialization: at rest, nothing depends */
     int n = v->n, m = n + 2, N = v->n_units;
     double dz[LCV_MAX_M] = {0}, dw[LCV_N_INPUTS] = {0};
@@ -712,10 +739,18 @@ int model_check_state(ModelInstance *c, const ModelState *s)
         snprintf(c->msg, sizeof c->msg, "the FMU state is refused: its text fields are not terminated");
         return -1;
     }
-    int phases = PhaseInstantiated | PhaseInitializationMode | PhaseStepComplete | PhaseTerminated | PhaseError;
-    /* one phase; a vehicle exactly when initialization has built one (StepComplete and
-       Terminated need it, Instantiated and InitializationMode have none) */
-    int needs_vehicle = s->phase == PhaseStepComplete || s->phase == PhaseTerminated;
+    if (s->model_exchange != c->model_exchange) {
+        snprintf(c->msg, sizeof c->msg, "the FMU state is refused: it was written by a %s instance, this one is a %s",
+                 s->model_exchange ? "Model Exchange" : "Co-Simulation",
+                 c->model_exchange ? "Model Exchange" : "Co-Simulation");
+        return -1;
+    }
+    int phases = PhaseInstantiated | PhaseInitializationMode | PhaseTerminated | PhaseError |
+                 (c->model_exchange ? PhaseEventMode | PhaseContinuousTimeMode : PhaseStepComplete);
+    /* one phase of this interface; a vehicle exactly when initialization has built one (StepComplete,
+       EventMode, ContinuousTimeMode and Terminated need it, Instantiated and InitializationMode have none) */
+    int needs_vehicle = s->phase == PhaseStepComplete || s->phase == PhaseTerminated || s->phase == PhaseEventMode ||
+                        s->phase == PhaseContinuousTimeMode;
     int has_none = s->phase == PhaseInstantiated || s->phase == PhaseInitializationMode;
     if (!(s->phase & phases) || (s->phase & (s->phase - 1)) || s->vehicle < -1 || s->vehicle >= LCV_N_VEHICLES ||
         (needs_vehicle && s->vehicle < 0) || (has_none && s->vehicle >= 0)) {

@@ -26,6 +26,7 @@ typedef struct {
     int vehicle;                        /* index into LCV_VEHICLES, -1 before initialization */
     char error[1024];                   /* why the instance is in PhaseError */
     double crossfall;                   /* fixed parameter [%] */
+    int model_exchange;                 /* written by a Model Exchange instance (1) or a Co-Simulation one (0) */
 } ModelState;
 
 typedef struct {

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <wchar.h>
 
 #include "loader_config.h"
@@ -209,6 +210,13 @@ static void forget_resources(const char *folder)
         folder);
 }
 
+/* remove every sys.path entry equal to ``path`` (as text: an alias whose link is about to go) */
+static void forget_path(const char *path)
+{
+    if (!python_ready) return;
+    (void)run_python_arg(python_lib, "import sys\nsys.path[:] = [p for p in sys.path if p != arg]\n", path);
+}
+
 static void bring_up(void)
 {
     const char *libpython = setting("LCV_FMU_LIBPYTHON", LOADER_LIBPYTHON);
@@ -318,6 +326,46 @@ void pyrt_instance_freed(const char *folder)
     int last = --live_instances == 0;
     pthread_mutex_unlock(&live_lock);
     if (last && folder) forget_resources(folder);
+}
+
+
+/* ------------------------------------------------------------------ the resources' alias */
+int pyrt_needs_alias(const char *folder)
+{
+    return strstr(folder, "%20") != NULL || strstr(folder, "file:/") != NULL;
+}
+
+int pyrt_resource_alias(const char *folder, char *alias, size_t size, char *why, size_t wsize)
+{
+    char dir[64];
+    snprintf(dir, sizeof dir, "/tmp/lcv-fmu-XXXXXX");
+    if (!mkdtemp(dir)) {
+        snprintf(why, wsize, "the resource folder %.1000s has \"%%20\" or \"file:/\" in its path, which the Python "
+                 "FMU's runtime rewrites, and no alias of it could be made under /tmp; unzip the FMU elsewhere", folder);
+        return 0;
+    }
+    snprintf(alias, size, "%s/resources", dir);
+    if (symlink(folder, alias) != 0) {
+        rmdir(dir);
+        snprintf(why, wsize, "the resource folder %.1000s has \"%%20\" or \"file:/\" in its path, and its alias "
+                 "could not be made; unzip the FMU elsewhere", folder);
+        return 0;
+    }
+    return 1;
+}
+
+void pyrt_resource_alias_free(const char *alias)
+{
+    if (!alias || !*alias) return;
+    forget_path(alias);
+    unlink(alias);
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", alias);
+    char *slash = strrchr(dir, '/');
+    if (slash) {
+        *slash = '\0';
+        rmdir(dir);
+    }
 }
 
 

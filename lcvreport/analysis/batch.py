@@ -33,6 +33,7 @@ import numpy as np
 
 from ..model.builder import system_coefficients
 from ..model.vehicle import Vehicle
+from ..ranges import RANGES
 from ..util.numerics import solve_scaled
 
 #: the coefficients the batch varies, and the parameters it can vary
@@ -600,7 +601,8 @@ class VariantBatch:
         :func:`lcvreport.analysis.field_measures.lane_change_measures` (the path-following lane
         change through each variant's inverse system): the last unit's rearmost axle's largest
         overshoot beyond the steered axle's final offset (0 if none), and max|a_N| / max|a_s|.
-        NaN where the inverse system is unstable or does not exist (measure_set's null)."""
+        NaN where the inverse system is unstable or does not exist, or the steer leaves
+        [-1, 1] rad (measure_set's null)."""
         from .exact import steered_point
         from .field_measures import DT_S, G_MPS2, LANE_CHANGE, LANE_CHANGE_TAIL_S
         from .geometry import point_lateral_map
@@ -625,11 +627,12 @@ class VariantBatch:
         ay_rows = self._ay_rows(u, [nu - 1])
 
         def signals(Mz, d_row, ctx):
-            C = np.zeros((Mz.shape[0], 3, Mz.shape[-1]))
+            C = np.zeros((Mz.shape[0], 4, Mz.shape[-1]))
             C[:, 0, :n + 2] = y_row                                             # Y of the rear axle
             C[:, 1] = ay_rows(Mz, d_row, ctx)[:, 0]                             # a_N
             C[:, 2] = Mz[:, 0] + xs * Mz[:, 1]                                  # a_s = v1' + x_s r1' + u r1
             C[:, 2, 1] += u
+            C[:, 3] = d_row                                                     # the steer (within [-1, 1] rad)
             return C
         hsto, ra = np.full(B, np.nan), np.full(B, np.nan)
         for g in range(0, B, RESPONSE_GROUP):
@@ -640,9 +643,10 @@ class VariantBatch:
                 continue
             hi, lo = self._extremes(u, steer, t_end, DT_S, signals, tire_scale, rows)
             over = (hi[:, 0] - offset) if sign > 0 else -(lo[:, 0] - offset)
-            hsto[rows] = np.maximum(0.0, over)
             peak = np.maximum(np.abs(hi), np.abs(lo))
-            ra[rows] = peak[:, 1] / peak[:, 2]
+            steer_ok = peak[:, 3] <= RANGES["steer_angle"].high                # else refused (measure_set's null)
+            hsto[rows[steer_ok]] = np.maximum(0.0, over[steer_ok])
+            ra[rows[steer_ok]] = peak[steer_ok, 1] / peak[steer_ok, 2]
         return hsto, ra
 
     def _inverse_stable(self, u: float, tire_scale: float, rows: np.ndarray) -> np.ndarray:
@@ -775,7 +779,6 @@ class VariantBatch:
         once: the coarse 4 km/h scan, the 1 km/h scan of each variant's own doubtful intervals,
         the bisection to 0.01 km/h, rounded to 0.1 km/h."""
         from ..analysis.measures import CRITICAL_SPEED_MAX_KPH, U_MIN_DEFAULT_MPS
-        from ..ranges import RANGES
         from ..units import mps_to_kph
         u_max_kph = CRITICAL_SPEED_MAX_KPH if u_max_kph is None else u_max_kph
         lo_kph = mps_to_kph(RANGES["u_min"].check(U_MIN_DEFAULT_MPS if u_min_mps is None else u_min_mps, "u_min"))

@@ -23,7 +23,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..util.files import FileInputError, read_text_file
+from ..util.files import FileInputError, loads_toml, read_text_file
 from .measures import FIELD_KEYS
 
 #: keys a limit may name
@@ -71,13 +71,13 @@ def load_criteria(path: str | Path) -> Criteria:
         Unreadable file, unknown keys, a limit without min or max, non-finite numbers, no source.
     """
     try:
-        doc = tomllib.loads(read_text_file(path, "criteria file"))
+        doc = loads_toml(read_text_file(path, "criteria file"))
     except FileInputError as exc:
         raise CriteriaError(str(exc)) from None
     except tomllib.TOMLDecodeError as exc:
         raise CriteriaError(f"not valid TOML: {exc}") from None
-    except ValueError as exc:           # an integer beyond Python's digit limit
-        raise CriteriaError(f"not valid TOML: {exc}") from None
+    except ValueError as exc:           # an integer beyond Python's digit limit: its line and key
+        raise CriteriaError(str(exc)) from None
     unknown = set(doc) - {"limits", "description"}
     if unknown or not isinstance(doc.get("limits"), dict) or not doc["limits"]:
         raise CriteriaError("needs a [limits] table (and an optional description), nothing else")

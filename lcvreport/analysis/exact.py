@@ -520,6 +520,27 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
     return ManoeuvreResponse(vehicle, u, steer, t_grid, signal_names, segments)
 
 
+def check_lane_change_steer(r: ManoeuvreResponse, peak_rad: float | None = None) -> None:
+    """Refuse a lane change whose steer -- the output of the inverse system, not an input the
+    user gave -- leaves the steer range of the ranges table ([-1, 1] rad: far beyond the small
+    angles of the linear model), naming the peak steer it would need.  ``peak_rad`` is max|delta|
+    when the caller has it (else it is located on the continuous response).
+
+    Raises
+    ------
+    ManoeuvreError
+    """
+    from ..ranges import RANGES
+    if not r.steer.prescribes_acceleration:
+        return
+    peak = float(r.peaks_abs(["delta"])[0]) if peak_rad is None else float(peak_rad)
+    rng = RANGES["steer_angle"]
+    if not peak <= rng.high:
+        raise ManoeuvreError(f"{r.steer.spec} at {r.speed_mps * 3.6:.4g} km/h needs a peak steer of {peak:.4g} rad, "
+                             f"outside the steer range {rng.text()} (the linear model's small angles): lower A0 or "
+                             "the frequency, or raise the speed; the manoeuvre is refused")
+
+
 def final_state(r: ManoeuvreResponse) -> np.ndarray:
     """[x, psi1, Y1] at the last sample of ``r`` (to continue a run in chunks)."""
     seg = r.segments[-1]

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..model.builder import check_speed, check_tire_scale, system_coefficients
 from ..model.vehicle import Vehicle
-from .exact import ManoeuvreError, ManoeuvreResponse, response
+from .exact import ManoeuvreError, ManoeuvreResponse, check_lane_change_steer, response
 from .geometry import point_lateral_map
 from .manoeuvres import G_MPS2, lane_change, lane_change_offset_m, pulse
 from .measures import steady_with_yaw_rate
@@ -242,7 +242,7 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
     Raises
     ------
     ManoeuvreError
-        No steered axle, or an unstable inverse system.
+        No steered axle, an unstable inverse system, or a steer beyond [-1, 1] rad.
     """
     steer = lane_change(accel_g * G_MPS2, f_hz)
     t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
@@ -251,7 +251,9 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
     rear = vehicle.units[-1].rearmost_axle.name
     steered = max(vehicle.steered_axles, key=lambda a: a.x_m).name
     sign = 1.0 if offset >= 0 else -1.0
-    (_t, Y), (_ta, a_n), (_ts, a_s) = r.extrema_many([f"Y_{rear}", f"ay{vehicle.n_units}", "a_steer"])
+    (_t, Y), (_ta, a_n), (_ts, a_s), (_td, d) = r.extrema_many([f"Y_{rear}", f"ay{vehicle.n_units}", "a_steer",
+                                                                 "delta"])
+    check_lane_change_steer(r, float(np.abs(d).max()))
     hsto = max(0.0, float(np.max(sign * (Y - offset))))
     ra = float(np.abs(a_n).max()) / float(np.abs(a_s).max())
     return LaneChangeMeasures(hsto, float(ra), offset, r, rear, steered)

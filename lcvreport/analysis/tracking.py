@@ -156,6 +156,9 @@ def tire_slots(vehicle: Vehicle, axles: list[str] | None = None) -> list[TireSlo
         unknown = [a for a in axles if a not in names]
         if unknown:
             raise TrackingError(f"unknown axle {unknown[0]!r} of {vehicle.name}; valid: {', '.join(names)}")
+        twice = next((a for k, a in enumerate(axles) if a in axles[:k]), None)
+        if twice is not None:
+            raise TrackingError(f"axle {twice!r} is named twice (its tires would count twice)")
         chosen = [names.index(a) for a in axles]
     out = []
     for j in chosen:
@@ -240,16 +243,15 @@ def read_mounted_tires(path) -> list[dict]:
     """
     import tomllib
     from pathlib import Path
-    from ..util.files import FileInputError, read_csv, read_text_file
+    from ..util.files import FileInputError, TomlNumberError, loads_toml, read_csv, read_text_file
     path = Path(path)
     try:
         if path.suffix.lower() == ".toml":
             try:
-                rows = tomllib.loads(read_text_file(path, "tire file", TIRE_FILE_MAX_BYTES)).get("tires")
-            except (tomllib.TOMLDecodeError, ValueError) as exc:
-                if isinstance(exc, FileInputError):
-                    raise
-                raise TrackingError(f"{path}: not valid TOML: {exc}") from None
+                rows = loads_toml(read_text_file(path, "tire file", TIRE_FILE_MAX_BYTES)).get("tires")
+            except (tomllib.TOMLDecodeError, TomlNumberError) as exc:
+                raise TrackingError(f"{path}: {'not valid TOML: ' if isinstance(exc, tomllib.TOMLDecodeError) else ''}"
+                                    f"{exc}") from None
             if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
                 raise TrackingError(f"{path}: expected [[tires]] tables")
         else:

@@ -44,7 +44,7 @@ import unicodedata
 from dataclasses import dataclass, field, replace
 from numbers import Integral, Real
 
-from ..ranges import VEHICLE, RangeError
+from ..ranges import GYRATION_PER_REACH_MIN, VEHICLE, RangeError
 
 #: names the vehicle itself may have (it is also the FMU's model name)
 VEHICLE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
@@ -250,6 +250,15 @@ class Unit:
         if not axles:
             raise VehicleError("axles", "a unit needs at least one axle, got none")
         set_("axles", axles)
+        reach = max(abs(x) for x in [a.x_m for a in axles] + [self.front_coupling_m, self.rear_coupling_m]
+                    if x is not None)
+        k = math.sqrt(self.yaw_inertia_kg_m2 / self.mass_kg)
+        if k < GYRATION_PER_REACH_MIN * reach:
+            raise VehicleError("yaw_inertia_kg_m2", f"yaw_inertia_kg_m2 {self.yaw_inertia_kg_m2:.4g} kg*m^2 of a "
+                               f"{self.mass_kg:.4g} kg unit is a radius of gyration sqrt(I/m) of {k:.3g} m, "
+                               f"{k / reach:.2g} of the {reach:.3g} m from its CG to its farthest axle or coupling; "
+                               f"below {GYRATION_PER_REACH_MIN:g} the model's eigenvalues are not reliable (a real "
+                               "body's is 0.05-2 of its length): the inertia or the mass is in another unit")
 
     @property
     def rearmost_axle(self) -> Axle:

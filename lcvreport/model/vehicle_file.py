@@ -63,11 +63,12 @@ lcvreport.model.vehicle_file.VehicleFileError: units[0] "truck" axles[0] "front"
 """
 from __future__ import annotations
 
+import json
 import tomllib
 import unicodedata
 from pathlib import Path
 
-from ..util.files import FileInputError, read_text_file
+from ..util.files import FileInputError, loads_toml, read_text_file
 from .vehicle import Axle, Unit, Vehicle, VehicleError
 
 #: the format tag of version 1
@@ -128,6 +129,12 @@ def _depth(value, limit: int = MAX_DEPTH) -> int:
     return deepest
 
 
+def _shown(name: str) -> str:
+    """A name as a message shows it: in double quotes, control characters escaped (a name
+    holding a newline or an ESC is one line of plain text, never a terminal command)."""
+    return json.dumps(name, ensure_ascii=False)
+
+
 def _table_list(value, key: str, where: str) -> list[dict]:
     if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
         raise VehicleFileError(key, f"{key} must be an array of tables ([[{key}]]), got {value!r}", where)
@@ -152,12 +159,13 @@ def vehicle_from_dict(doc: dict, source: str = "") -> Vehicle:
     units = []
     for i, ut in enumerate(_table_list(doc["units"], "units", "")):
         uname = ut.get("name")
-        where = f'units[{i}] "{uname}"' if isinstance(uname, str) else f"units[{i}]"
+        where = f"units[{i}] {_shown(uname)}" if isinstance(uname, str) else f"units[{i}]"
         _keys(ut, UNIT_KEYS, where)
         axles = []
         for j, at in enumerate(_table_list(ut["axles"], "axles", where)):
             aname = at.get("name")
-            awhere = f'{where} axles[{j}] "{aname}"' if isinstance(aname, (str, int)) else f"{where} axles[{j}]"
+            awhere = f"{where} axles[{j}] {_shown(str(aname))}" if isinstance(aname, (str, int)) else \
+                f"{where} axles[{j}]"
             _keys(at, AXLE_KEYS, awhere)
             try:
                 axles.append(Axle(**at))
@@ -180,13 +188,13 @@ def loads_vehicle(text: str, source: str = "") -> Vehicle:
                                    f"{MAX_FILE_BYTES} bytes")
     _check_key_lengths(text)
     try:
-        doc = tomllib.loads(text)
+        doc = loads_toml(text)
     except tomllib.TOMLDecodeError as exc:
         raise VehicleFileError("", f"not valid TOML: {exc}") from None
     except (RecursionError, MemoryError):
         raise VehicleFileError("", "not a vehicle file: its TOML nests too deeply") from None
-    except ValueError as exc:          # e.g. an integer beyond Python's digit limit
-        raise VehicleFileError("", f"not valid TOML: {exc}") from None
+    except ValueError as exc:          # an integer beyond Python's digit limit: its line and key
+        raise VehicleFileError("", str(exc)) from None
     return vehicle_from_dict(doc, source)
 
 

@@ -411,9 +411,10 @@ class Assessment:
         """The first page's summary: the vehicle's description and the headline measures."""
         m = self.measures
         lines = []
+        from .reporting import md_text
         if self.vehicle.description:
-            lines += [f"*{self.vehicle.name}*: {self.vehicle.description}", ""]
-        lines += [f"At {self.speed_kph:g} km/h ({self.source}):", ""]
+            lines += [f"*{md_text(self.vehicle.name)}*: {md_text(self.vehicle.description)}", ""]
+        lines += [f"At {self.speed_kph:g} km/h ({md_text(self.source)}):", ""]
         zeta = "no oscillatory mode" if m.least_damping_ratio is None else \
             f"{m.least_damping_ratio:.3f} at {m.least_damped_frequency_hz:.3f} Hz"
         lines.append(f"- least damping ratio: {zeta}")
@@ -425,7 +426,7 @@ class Assessment:
             lines.append(f"- rearward amplification at {m.f_hz:g} Hz: {m.ra_frequency:.3f} (frequency domain), "
                          f"{m.ra_single_sine:.3f} (single sine)")
         if m.trim is not None:
-            lines.append(f"- trimmed offtracking under the 1 % rule on {', '.join(self.load_units)}: "
+            lines.append(f"- trimmed offtracking under the 1 % rule on {md_text(', '.join(self.load_units))}: "
                          f"{1e3 * m.trim.offtracking_m:.1f} mm (trim steer {1e3 * m.trim.delta_rad:.3f} mrad)")
         return "\n".join(lines)
 

@@ -45,6 +45,7 @@ from ..model.loads import CONVENTIONS
 from ..model.presets import PRESETS, load_preset
 from ..ranges import RANGES
 from ..units import MPS_PER_KPH, MPS_PER_MPH
+from .reporting import md_text
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
 MATHJAX = Path("/usr/share/javascript/mathjax")
@@ -529,6 +530,61 @@ def check_output_folder(out_dir: str | Path) -> Path:
     return out
 
 
+def _stage(out: Path) -> Path:
+    """A new hidden folder beside ``out`` to write the report into: ``.<name>.writing-<pid>-XXXX``.
+    Folders of that form left by a process that no longer runs (SIGKILL, a power cut) are removed
+    first: they are this command's, and nobody else writes them."""
+    import os
+    import re
+    import tempfile
+    pattern = re.compile(rf"\.{re.escape(out.name)}\.(?:writing|replaced)-(\d+)(?:-.*)?\Z")
+    for p in out.parent.iterdir() if out.parent.is_dir() else ():
+        m = pattern.match(p.name)
+        if m and p.is_dir() and not p.is_symlink() and not _alive(int(m.group(1))):
+            shutil.rmtree(p, ignore_errors=True)
+    return Path(tempfile.mkdtemp(prefix=f".{out.name}.writing-{os.getpid()}-", dir=out.parent))
+
+
+def _alive(pid: int) -> bool:
+    import os
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _stop_kernels() -> None:
+    """Kill the notebook kernels this process started (an interrupted report: the kernel runs
+    in a session of its own, so Ctrl-C does not reach it, and it must not outlive -- or print
+    into -- the folder about to be removed)."""
+    try:
+        import psutil
+    except ImportError:                     # pragma: no cover - ipykernel brings psutil
+        return
+    try:
+        children = psutil.Process().children(recursive=True)
+    except psutil.Error:                    # pragma: no cover
+        return
+    kernels = []
+    for child in children:
+        try:
+            if any("ipykernel" in part for part in child.cmdline()):
+                child.kill()
+                kernels.append(child)
+        except psutil.Error:
+            pass
+    psutil.wait_procs(kernels, timeout=10)
+
+
+def _discard(staged: Path) -> None:
+    """Remove a report's staging folder after a failure or an interruption: its kernels first."""
+    _stop_kernels()
+    shutil.rmtree(staged, ignore_errors=True)
+
+
 def _publish(staged: Path, out: Path, existed_as: tuple) -> None:
     """Move the finished report ``staged`` into place as ``out`` (renames on one file
     system: a reader sees the old report or the new one, never a mix)."""
@@ -612,7 +668,6 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
     """
     import os
-    import tempfile
     from ..model.vehicle_file import dumps_vehicle
     from importlib.metadata import version
     __version__ = version("lcvreport")
@@ -621,7 +676,7 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
     progress = progress or (lambda _text: None)
     out = check_output_folder(out_dir)
     before = _folder_state(out)
-    staged = Path(tempfile.mkdtemp(prefix=f".{out.name}.writing-", dir=out.parent))
+    staged = _stage(out)
     try:
         data_dir = staged / "data"
         data_dir.mkdir()
@@ -641,14 +696,14 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         progress(f"notebook assessment: {time.perf_counter() - t0:.1f} s")
         title = f"Yaw-plane assessment of {vehicle.name} at {speed_kph:g} km/h"
         stamp = time.strftime("%Y-%m-%d", time.gmtime(int(os.environ.get("SOURCE_DATE_EPOCH", time.time()))))
-        intro = (f"Linear yaw-plane model of *{vehicle.name}* ({vehicle.n_units} units: "
-                 f"{', '.join(vehicle.unit_names)}){' from ' + source if source else ''}, assessed at {speed_kph:g} km/h "
-                 f"(SI units; speeds in km/h). Written by lcvreport {__version__} on {stamp}.")
+        intro = (f"Linear yaw-plane model of *{md_text(vehicle.name)}* ({vehicle.n_units} units: "
+                 f"{md_text(', '.join(vehicle.unit_names))}){' from ' + md_text(source) if source else ''}, assessed "
+                 f"at {speed_kph:g} km/h (SI units; speeds in km/h). Written by lcvreport {__version__} on {stamp}.")
         written = _finish_single(staged, out, before, ("assessment", "assessment", title, path), title, intro,
                                  pdf, f"lcvreport {__version__} assessment of {vehicle.name}", paper,
                                  f"lcvreport {__version__} (lcv report)", progress)
     except BaseException:
-        shutil.rmtree(staged, ignore_errors=True)
+        _discard(staged)
         raise
     res = {key: out / name for key, name in written.items()}
     res["seconds"] = time.perf_counter() - t0
@@ -689,7 +744,6 @@ def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf
         ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
     """
     import os
-    import tempfile
     from importlib.metadata import version
     from ..study.results import read_study, stored_study
     from ..study.spec import StudyError
@@ -705,7 +759,7 @@ def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf
         raise ReportError(str(exc)) from None
     out = check_output_folder(out_dir)
     before = _folder_state(out)
-    staged = Path(tempfile.mkdtemp(prefix=f".{out.name}.writing-", dir=out.parent))
+    staged = _stage(out)
     try:
         data_dir = staged / "data"
         data_dir.mkdir()
@@ -718,14 +772,14 @@ def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf
         progress(f"notebook study: {time.perf_counter() - t0:.1f} s")
         title = f"Study of {study.vehicle.name}: {study.n_cases} cases"
         stamp = time.strftime("%Y-%m-%d", time.gmtime(int(os.environ.get("SOURCE_DATE_EPOCH", time.time()))))
-        intro = (f"The results of `lcv study` in {study_dir.name}: {study.n_cases} cases of *{study.vehicle.name}*, "
-                 f"measures {', '.join(study.measures)} (SI units; speeds in km/h). Written by lcvreport "
-                 f"{__version__} on {stamp}.")
+        intro = (f"The results of `lcv study` in {md_text(study_dir.name)}: {study.n_cases} cases of "
+                 f"*{md_text(study.vehicle.name)}*, measures {md_text(', '.join(study.measures))} (SI units; speeds "
+                 f"in km/h). Written by lcvreport {__version__} on {stamp}.")
         written = _finish_single(staged, out, before, ("study", "study", title, path), title, intro, pdf,
                                  f"lcvreport {__version__} study of {study.vehicle.name}", paper,
                                  f"lcvreport {__version__} (lcv study --report)", progress)
     except BaseException:
-        shutil.rmtree(staged, ignore_errors=True)
+        _discard(staged)
         raise
     res = {key: out / name for key, name in written.items()}
     res["seconds"] = time.perf_counter() - t0

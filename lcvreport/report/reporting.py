@@ -148,6 +148,30 @@ def _latex_escape(text: str) -> str:
     return "".join(out)
 
 
+#: the characters Markdown (CommonMark, and pandoc's Markdown) treats as syntax: each is escaped
+MARKDOWN_PUNCTUATION = frozenset(r"""!"#$%&'()*+,-./:;<=>?@[\]^_`{|}~""")
+
+
+def md_text(text) -> str:
+    r"""``text`` -- a vehicle's description, a file path, a criteria file's source, any string a
+    user wrote -- as Markdown that renders it literally, in the HTML and in the PDF.
+
+    Every ASCII punctuation character is backslash-escaped (CommonMark and pandoc both read
+    ``\<`` as a plain ``<``), so HTML tags, links, emphasis, LaTeX commands (``\input``) and
+    math delimiters (``$``) in it are text; line breaks become spaces; and the whole sits in a
+    ``tex2jax_ignore`` span, so that MathJax leaves it alone (pandoc keeps the span's text in
+    the LaTeX).  Interpolate user strings into Markdown through this, never raw.
+
+    Examples
+    --------
+    >>> md_text("<img src=x onerror=alert(1)>")
+    '<span class="tex2jax_ignore">\\<img src\\=x onerror\\=alert\\(1\\)\\></span>'
+    """
+    text = " ".join(str(text).split())
+    return '<span class="tex2jax_ignore">' + "".join("\\" + c if c in MARKDOWN_PUNCTUATION else c
+                                                       for c in text) + "</span>"
+
+
 class Table:
     """A table with its caption, rendered as HTML, LaTeX (PDF) or Markdown.
 
@@ -282,7 +306,8 @@ class Table:
         head = "".join(f'<th style="text-align:{a}">{html.escape(h)}</th>' for h, a in zip(self.headers, align))
         body = "".join("<tr>" + "".join(f'<td style="text-align:{a}">{html.escape(c)}</td>'
                                         for c, a in zip(row, align)) + "</tr>" for row in self.cells)
-        return (f'<table class="lcv-table"><caption style="caption-side:top;text-align:left">'
+        # tex2jax_ignore: MathJax leaves the cells alone (tire ids, sources: text the user wrote)
+        return (f'<table class="lcv-table tex2jax_ignore"><caption style="caption-side:top;text-align:left">'
                 f"<b>Table {html.escape(self.number)}.</b> {_code_spans(self.caption, html.escape, 'html')}</caption>"
                 f"<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
 

@@ -284,6 +284,8 @@ WORKER_CONFIG = {
     "distributed.nanny.pre-spawn-environ.OMP_NUM_THREADS": "1",
     "distributed.nanny.pre-spawn-environ.MKL_NUM_THREADS": "1",
     "distributed.worker.profile.enabled": False,
+    # the workers log errors only: a chunk cancelled by Ctrl-C is not the user's concern
+    "distributed.nanny.pre-spawn-environ.DASK_LOGGING__DISTRIBUTED": "error",
 }
 
 
@@ -336,7 +338,8 @@ def probe_scheduler(address: str, timeout_s: float = SCHEDULER_TIMEOUT_S) -> dic
     try:
         reply = asyncio.run(bounded())
     except (asyncio.TimeoutError, TimeoutError):
-        raise StudyError(f"--scheduler {address}: no Dask scheduler answered there within {timeout_s:g} s") from None
+        raise StudyError(f"--scheduler {address}: no Dask scheduler answers there (no answer within "
+                         f"{timeout_s:g} s)") from None
     except (OSError, EOFError) as exc:
         raise StudyError(f"--scheduler {address}: no Dask scheduler answers there "
                          f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'closed'})") from None
@@ -348,10 +351,36 @@ def probe_scheduler(address: str, timeout_s: float = SCHEDULER_TIMEOUT_S) -> dic
     return reply
 
 
+class _workers_quiet:
+    """While the local cluster starts its worker processes: file descriptor 2 points at
+    /dev/null, so that the workers inherit it as their standard error.  Ctrl-C reaches the whole
+    foreground process group -- the workers too -- and a worker's traceback then goes nowhere;
+    this process keeps its own standard error (restored before anything is printed) and acts on
+    Ctrl-C alone: the chunks are cancelled and the cluster closed.  A worker's failure still
+    reaches this process through its future."""
+
+    def __enter__(self):
+        sys.stderr.flush()
+        self.saved = os.dup(2)
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 2)
+        os.close(null)
+        return self
+
+    def __exit__(self, *exc):
+        try:
+            sys.stderr.flush()
+        except (OSError, ValueError):
+            pass
+        os.dup2(self.saved, 2)
+        os.close(self.saved)
+        return False
+
+
 def _run_distributed(study, todo, bounds, chunks, workers, scheduler, bar) -> None:
     import logging
     from dask.distributed import Client, LocalCluster, as_completed
-    logging.getLogger("distributed").setLevel(logging.ERROR)
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)     # failures reach us through the futures
     doc = study.to_dict()
     cluster = None
     try:
@@ -362,7 +391,7 @@ def _run_distributed(study, todo, bounds, chunks, workers, scheduler, bar) -> No
                 raise StudyError(f"--scheduler {scheduler}: no Dask scheduler answers there ({exc})") from None
         else:
             import dask
-            with dask.config.set(WORKER_CONFIG):
+            with dask.config.set(WORKER_CONFIG), _workers_quiet():
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                        dashboard_address=None)
             client = Client(cluster)

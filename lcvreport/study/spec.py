@@ -182,7 +182,7 @@ class Study:
         after its scale factors -- naming the factor, the first such case and the range;
         block by block (:data:`DRAW_BLOCK` cases), in constant memory, before anything is
         computed (a model far outside the ranges gives numbers that mean nothing)."""
-        from ..ranges import VEHICLE
+        from ..ranges import GYRATION_PER_REACH_MIN, VEHICLE
         n = self.n_cases
         if not self.factors:
             return
@@ -208,7 +208,8 @@ class Study:
                 if bad.size:
                     raise StudyError(f"factors.{name}: case {int(ids[bad[0]])} has {vals[bad[0]]:.6g}; it must be in "
                                      f"{r.text()} ({r.description})")
-            for pname, vals in self.batch_parameters(table).items():
+            params = self.batch_parameters(table)
+            for pname, vals in params.items():
                 owner, key = pname.split(".", 1)
                 r = VEHICLE[key]
                 vals = np.asarray(vals, dtype=float)
@@ -220,6 +221,22 @@ class Study:
                     given = ", ".join(f"{f} = {float(table[f][k]):.6g}" for f in used)
                     raise StudyError(f"factors.{used[0] if used else pname}: case {int(ids[k])} makes {pname} "
                                      f"{vals[k]:.6g} {r.unit} ({given}); {key} must be in {r.text()}")
+            for u in self.vehicle.units:
+                m = np.asarray(params.get(f"{u.name}.mass_kg", u.mass_kg), dtype=float)
+                inertia = np.asarray(params.get(f"{u.name}.yaw_inertia_kg_m2", u.yaw_inertia_kg_m2), dtype=float)
+                reach = max(abs(x) for x in [a.x_m for a in u.axles] + [u.front_coupling_m, u.rear_coupling_m]
+                            if x is not None)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    k = np.sqrt(np.maximum(inertia, 0.0) / np.where(m > 0, m, np.nan))
+                bad = np.flatnonzero(np.broadcast_to(k < GYRATION_PER_REACH_MIN * reach, ids.shape))
+                if bad.size:
+                    i = int(bad[0])
+                    used = [f.name for f in self.factors
+                            if f.name in (f"{u.name}.mass_scale", f"{u.name}.yaw_inertia_scale")]
+                    raise StudyError(f"factors.{used[0] if used else u.name}: case {int(ids[i])} gives {u.name} a "
+                                     f"radius of gyration sqrt(I/m) of {float(np.broadcast_to(k, ids.shape)[i]):.3g} m, "
+                                     f"below {GYRATION_PER_REACH_MIN:g} of its {reach:.3g} m reach (its eigenvalues "
+                                     "would not be reliable)")
 
     def factor_table(self, case_ids) -> dict:
         """Every factor's value for the cases ``case_ids``: name -> array (file order)."""
@@ -506,16 +523,16 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
 
 def load_study(path) -> Study:
     """Read and check a study file (TOML)."""
-    from ..util.files import FileInputError, read_text_file
+    from ..util.files import FileInputError, loads_toml, read_text_file
     path = Path(path)
     try:
-        doc = tomllib.loads(read_text_file(path, "study file"))
+        doc = loads_toml(read_text_file(path, "study file"))
     except FileInputError as exc:
         raise StudyError(str(exc)) from None
     except tomllib.TOMLDecodeError as exc:
         raise StudyError(f"study file {path} is not valid TOML: {exc}") from None
-    except ValueError as exc:          # an integer beyond Python's digit limit
-        raise StudyError(f"study file {path} is not valid TOML: {exc}") from None
+    except ValueError as exc:          # an integer beyond Python's digit limit: its line and key
+        raise StudyError(f"study file {path}: {exc}") from None
     return study_from_dict(doc, path.parent)
 
 

@@ -161,3 +161,43 @@ def read_csv(path: str | Path, what: str, columns: tuple[str, ...], optional: tu
             raise FileInputError(f"{path}: line {line} has {len(row)} values, the header {len(header)} columns")
         out.append((line, {name: (row[k] if k < len(row) else "") for k, name in enumerate(header)}))
     return out
+
+
+class TomlNumberError(ValueError):
+    """A TOML number Python cannot convert (an integer of thousands of digits), with its line and key."""
+
+
+def loads_toml(text: str) -> dict:
+    """:func:`tomllib.loads`, saying in one line what tomllib cannot: an integer literal too long
+    to convert (Python's digit limit) is named by its line and key (:class:`TomlNumberError`).
+
+    Raises
+    ------
+    tomllib.TOMLDecodeError
+        Not valid TOML.
+    TomlNumberError
+        An integer of more digits than Python converts.
+
+    Examples
+    --------
+    >>> loads_toml("mass_kg = " + "9" * 5000)
+    Traceback (most recent call last):
+    ...
+    lcvreport.util.files.TomlNumberError: line 1: mass_kg is an integer of 5000 digits; a number here has a physical size
+    """
+    import re
+    import tomllib
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        raise
+    except ValueError as exc:
+        m = re.search(r"[0-9_]{1000,}", text)
+        if m is None:
+            raise TomlNumberError(f"not valid TOML: {str(exc).split(';')[0]}") from None
+        line_no = text.count("\n", 0, m.start()) + 1
+        head = text[text.rfind("\n", 0, m.start()) + 1:m.start()]
+        key = re.search(r"([A-Za-z0-9_.\"'-]+)\s*=\s*[-+]?$", head)
+        digits = len(m.group(0).replace("_", ""))
+        raise TomlNumberError(f"line {line_no}: {key.group(1) if key else 'a value'} is an integer of {digits} "
+                              "digits; a number here has a physical size") from None
