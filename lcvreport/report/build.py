@@ -579,8 +579,15 @@ def _stop_kernels() -> None:
     psutil.wait_procs(kernels, timeout=10)
 
 
-def _discard(staged: Path) -> None:
-    """Remove a report's staging folder after a failure or an interruption: its kernels first."""
+def _discard(staged: Path, interrupted: bool = False) -> None:
+    """Remove a report's staging folder after a failure or an interruption: its kernels first.
+    After an interruption the notebook client's event loop still waits in its own thread for the
+    cell the kernel was running; the loggers it reports through are silenced first, so that the
+    kernel's end is not reported as an error (the interruption is the one line)."""
+    if interrupted:
+        import logging
+        for name in ("traitlets", "nbclient", "papermill", "jupyter_client"):
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
     _stop_kernels()
     shutil.rmtree(staged, ignore_errors=True)
 
@@ -702,8 +709,8 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
         written = _finish_single(staged, out, before, ("assessment", "assessment", title, path), title, intro,
                                  pdf, f"lcvreport {__version__} assessment of {vehicle.name}", paper,
                                  f"lcvreport {__version__} (lcv report)", progress)
-    except BaseException:
-        _discard(staged)
+    except BaseException as exc:
+        _discard(staged, isinstance(exc, KeyboardInterrupt))
         raise
     res = {key: out / name for key, name in written.items()}
     res["seconds"] = time.perf_counter() - t0
@@ -778,8 +785,8 @@ def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf
         written = _finish_single(staged, out, before, ("study", "study", title, path), title, intro, pdf,
                                  f"lcvreport {__version__} study of {study.vehicle.name}", paper,
                                  f"lcvreport {__version__} (lcv study --report)", progress)
-    except BaseException:
-        _discard(staged)
+    except BaseException as exc:
+        _discard(staged, isinstance(exc, KeyboardInterrupt))
         raise
     res = {key: out / name for key, name in written.items()}
     res["seconds"] = time.perf_counter() - t0
