@@ -32,6 +32,7 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``low_speed_turn``   the low-speed 90° turn: swept width, offtracking, tail and frontal swing (SPEC 16)
     ``driver``           a path-following driver with preview, the closed loop of vehicle and driver
     ``batch``            variants of a vehicle in a batch: matrices and damping over the leading axis
+    ``registry``         every measure once: key, label, unit, definition, limit kind, how it is batched
     ``criteria``         the user's limits and the verdicts
     ``tracking``         per-tire conicity and ply steer, fleet statistics of the trimmed offtracking
     ``placement``        which measured tire goes where: the exact mounting plan (a mixed-integer program)

@@ -82,6 +82,11 @@ def _ranged(key: str, factor: float = 1.0, unit: str | None = None, what: str = 
     return conv
 
 
+def _help_range(key: str, factor: float = 1.0, unit: str | None = None) -> str:
+    """The valid range of ``key`` for a help text (argparse formats help with %: a unit of % is doubled)."""
+    return RANGES[key].text(factor, unit).replace("%", "%%")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``lcv``."""
     from .model.presets import MASS_OPTIONS, PRESETS
@@ -104,14 +109,14 @@ def build_parser() -> argparse.ArgumentParser:
     def speed(sp: argparse.ArgumentParser, required: bool = True) -> None:
         g = sp.add_mutually_exclusive_group(required=required)
         g.add_argument("--speed-kph", type=_ranged("speed", 1 / MPS_PER_KPH, "km/h", "forward speed in km/h"),
-                       metavar="V", help=f"forward speed [km/h], in {RANGES['speed'].text(1 / MPS_PER_KPH, 'km/h')}")
+                       metavar="V", help=f"forward speed [km/h], in {_help_range('speed', 1 / MPS_PER_KPH, 'km/h')}")
         g.add_argument("--speed-mph", type=_ranged("speed", 1 / MPS_PER_MPH, "mph", "forward speed in mph"),
-                       metavar="V", help=f"forward speed [mph], in {RANGES['speed'].text(1 / MPS_PER_MPH, 'mph')}")
+                       metavar="V", help=f"forward speed [mph], in {_help_range('speed', 1 / MPS_PER_MPH, 'mph')}")
 
     def tires(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("--tire-scale", default=1.0, type=_ranged("tire_scale", what="factor on the tire "
                         "coefficients"), metavar="S",
-                        help=f"factor on every tire coefficient (chapter V), in {RANGES['tire_scale'].text()}; "
+                        help=f"factor on every tire coefficient (chapter V), in {_help_range('tire_scale')}; "
                              "default 1")
 
     def load(sp: argparse.ArgumentParser, required: bool, convention: bool = True) -> None:
@@ -141,9 +146,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="residual force P [N] (+y) and moment T [N*m] (+z) on an axle; repeatable")
         sp.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
                         help=f"thrust angle of an axle [rad], nose-right positive, in "
-                             f"{RANGES['misalignment'].text()}; repeatable or comma-separated")
+                             f"{_help_range('misalignment')}; repeatable or comma-separated")
         sp.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
-                        help=f"road crossfall [%%], positive falling toward +y, in {RANGES['crossfall'].text()}")
+                        help=f"road crossfall [%%], positive falling toward +y, in {_help_range('crossfall')}")
         sp.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML: position, conicity_N, "
                                                          "ply_steer_N, serial_side[, moments]): their axle P and T")
 
@@ -155,10 +160,11 @@ def build_parser() -> argparse.ArgumentParser:
                      help="steer input: step:A, sine:A:F, pulse:A:D, csv:FILE, lane-change:A0:F (A0 in m/s^2 or "
                           "with g, e.g. 0.15g); default none")
     sim.add_argument("--t-end", default=10.0, type=_ranged("t_end", what="end time in s"), metavar="T",
-                     help=f"end time [s], in {RANGES['t_end'].text()}; default 10")
+                     help=f"end time [s], in {_help_range('t_end')}; default 10")
     sim.add_argument("--dt", default=0.01, type=_ranged("output_step", what="output step in s"), metavar="H",
-                     help=f"output step [s], in {RANGES['output_step'].text()}; must divide t-end; default 0.01")
-    mea = sub.add_parser("measures", help="yaw-plane measures: damping, RA, YDC, HSTO, HSSO, trim (SPEC 8, 12)")
+                     help=f"output step [s], in {_help_range('output_step')}; must divide t-end; default 0.01")
+    mea = sub.add_parser("measures", help="yaw-plane measures: damping, RA, YDC, HSTO, HSSO, trim, the low-speed "
+                                          "turn (defined in docs/measures.md)")
     source(mea)
     g = mea.add_mutually_exclusive_group(required=True)
     g.add_argument("--speed-kph", metavar="V", help="forward speed [km/h], or a sweep START:STOP:STEP")
@@ -190,7 +196,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="a tire population for the straight-line tracking chapter: conicity=DIST,ply_steer=DIST,"
                           "mounting=out|in|random[,conicity_moment=DIST,ply_steer_moment=DIST,draws=N,seed=S,"
                           "lane_width_m=W,body_width_m=B], DIST = normal:MEAN:SD | uniform:LO:HI [N, N*m]")
-    trk = sub.add_parser("tracking", help="straight-line tracking: per-tire conicity and ply steer (SPEC 13)")
+    trk = sub.add_parser("tracking", help="straight-line tracking: per-tire conicity and ply steer")
     tsub = trk.add_subparsers(dest="tracking_command", metavar="WHAT", parser_class=_Parser)
     tsub.required = True
     st = tsub.add_parser("stats", help="offtracking over a tire population: exact mean and SD, Monte Carlo lane "
@@ -210,7 +216,7 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--draws", type=int, default=1_000_000, metavar="N", help="Monte Carlo draws (1e6)")
     st.add_argument("--seed", type=int, default=20110801, metavar="S", help="random seed (printed)")
     st.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
-                    help=f"road crossfall [%%], in {RANGES['crossfall'].text()}")
+                    help=f"road crossfall [%%], in {_help_range('crossfall')}")
     st.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
                     help="thrust angle of an axle [rad]; repeatable or comma-separated")
     st.add_argument("--json", action="store_true", help="machine-readable output")
@@ -224,24 +230,24 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--positions", metavar="POS,POS,...",
                     help="positions to fill, axle:slot (default: every tire position of units 2..N)")
     pl.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
-                    help=f"road crossfall [%%], in {RANGES['crossfall'].text()}")
+                    help=f"road crossfall [%%], in {_help_range('crossfall')}")
     pl.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
                     help="thrust angle of an axle [rad]; repeatable or comma-separated")
     pl.add_argument("--draws", type=int, default=10_000, metavar="N", help="random placements to compare (1e4)")
     pl.add_argument("--seed", type=int, default=20110801, metavar="S", help="seed of the random placements")
     pl.add_argument("--json", action="store_true", help="machine-readable output")
-    turn = sub.add_parser("turn", help="low-speed 90 degree turn: swept width, offtracking, tail and frontal swing "
-                                       "(kinematic model, SPEC 16)")
+    turn = sub.add_parser("turn", help="low-speed turn (90 deg by default): swept width, offtracking, tail and "
+                                       "frontal swing (kinematic model, docs/low_speed_turn.md)")
     source(turn, masses=False)
     turn.add_argument("--radius", type=_ranged("turn_radius", what="outside steer wheel radius in m"), default=12.5,
                       metavar="R", help=f"radius of the outside steer wheel's path [m], in "
-                                        f"{RANGES['turn_radius'].text()}; default 12.5")
+                                        f"{_help_range('turn_radius')}; default 12.5")
     turn.add_argument("--angle-deg", type=_ranged("turn_angle", what="turn angle in deg"), default=90.0, metavar="A",
-                      help=f"angle of the turn [deg], in {RANGES['turn_angle'].text()}; default 90")
+                      help=f"angle of the turn [deg], in {_help_range('turn_angle')}; default 90")
     turn.add_argument("--plot", metavar="FILE", help="draw the swept path into FILE (.png, .pdf or .svg; a new file)")
     turn.add_argument("--json", action="store_true", help="machine-readable output")
     st = sub.add_parser("study", help="a study file's cases (factors, design, measures) in batches on Dask, "
-                                      "results in Parquet (SPEC 14)")
+                                      "results in Parquet")
     st.add_argument("study_file", metavar="STUDY.toml", help="the study file")
     st.add_argument("--out", required=True, metavar="DIR", help="results folder: new, empty, or this study's "
                                                                "earlier results (then only missing chunks run)")
@@ -640,12 +646,14 @@ def _flatten(doc: dict, vehicle) -> dict:
         if key == "ay_gain_per_unit":
             for name, g in zip(vehicle.unit_names, val or [None] * vehicle.n_units):
                 flat[f"ay_gain_{name}_m_per_s2_per_rad"] = g
-        elif key == "trim":
-            flat["trim_delta_rad"] = None if val is None else val["delta_rad"]
-            flat["trim_offtracking_m"] = None if val is None else val["offtracking_m"]
+        elif key == "trim":                      # the registry's keys (trim.delta_rad, trim.offtracking_m)
+            flat["trim.delta_rad"] = None if val is None else val["delta_rad"]
+            flat["trim.offtracking_m"] = None if val is None else val["offtracking_m"]
         elif key == "verdicts":
             for k, verdict in val.items():
                 flat[f"verdict_{k}"] = verdict["verdict"]
+        elif key == "reasons":                   # the text output and the JSON say why; a CSV cell is a number
+            continue
         else:
             flat[key] = val
     return flat
@@ -842,13 +850,19 @@ def _cmd_turn(args, out: _Out) -> int:
     if args.json:
         out.json(t.to_dict())
         return 0
-    out.line(f"{v.name}: low-speed {t.angle_deg:g} deg turn, outside steer wheel on R = {t.radius_m:g} m "
-             f"(steered axle centre on {t.steer_axle_radius_m:.3f} m); overall length {t.overall_length_m:.2f} m")
-    out.line(f"  swept width (lssp)        {t.lssp_m:8.3f} m")
-    out.line(f"  low-speed offtracking     {t.low_speed_offtracking_m:8.3f} m")
-    out.line(f"  frontal swing             {t.frontal_swing_m:8.3f} m")
+    centre = "" if t.steer_axle_radius_m is None else \
+        f" (steered axle centre on up to {t.steer_axle_radius_m:.3f} m)"
+    out.line(f"{v.name}: low-speed {t.angle_deg:g} deg turn, outside steer wheel on R = {t.radius_m:g} m{centre}; "
+             f"overall length {t.overall_length_m:.2f} m")
+    for label, key, value in (("swept width (lssp)", "lssp_m", t.lssp_m),
+                              ("low-speed offtracking", "low_speed_offtracking_m", t.low_speed_offtracking_m),
+                              ("frontal swing", "frontal_swing_m", t.frontal_swing_m)):
+        out.line(f"  {label:<25} {value:8.3f} m" if value is not None else
+                 f"  {label:<25} not computed: {_line(t.undefined.get(key, ''))}")
     for name, val in t.tail_swing_m.items():
         out.line(f"  tail swing, {name:<13} {val:8.3f} m")
+    if not t.tail_swing_m:
+        out.line(f"  {'tail swing':<25} not computed: {_line(t.undefined.get('max_tail_swing_m', ''))}")
     if plot is not None:
         out.line(f"wrote {plot}")
     return 0

@@ -155,7 +155,8 @@ RANGES: dict[str, Range] = dict([
     ("crossfall", Range("crossfall", "%", -20.0, 20.0, description="road crossfall, positive falling toward +y")),
     ("turn_radius", Range("turn radius", "m", 2.0, 100.0,
                           description="radius of the outside steer wheel's path in the low-speed turn")),
-    ("turn_angle", Range("turn angle", "deg", 0.0, 360.0, low_open=True, description="angle of the low-speed turn")),
+    ("turn_angle", Range("turn angle", "deg", 0.0, 3600.0, low_open=True,
+                         description="angle of the low-speed turn (ten laps at most)")),
 ])
 
 #: vehicle-file limits (SI, per tire where the file is per tire)

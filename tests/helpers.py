@@ -167,3 +167,71 @@ def schedule(rng: np.random.Generator, n_steps: int, step_sizes, axles, changes:
                 inputs[T.format(a)] = float(rng.normal(0, 300.0))
         steps.append((h, inputs))
     return steps
+
+
+def chain_on_circle_by_root_finding(vehicle: Vehicle, beta, radius_m: float):
+    """An independent construction of SPEC 12's steady-turn geometry (corrected 2026-12), in world
+    coordinates with brentq: the turn centre O at the origin; unit 1's axis at R from O (O at
+    (-beta_1 R, R) in its frame); every next unit placed so that its front coupling is the point
+    of the unit ahead's rear coupling and O lies at (-beta d, d) in its frame, d found by brentq on
+    the coupling's radius.  Returns a function radius(unit, x) [m] of any point of any unit."""
+    from scipy.optimize import brentq
+    beta = np.asarray(beta, dtype=float)
+
+    def rot(phi, p):
+        c, s = np.cos(phi), np.sin(phi)
+        return np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]])
+    cg, phi = [np.array([beta[0] * radius_m, -radius_m])], [0.0]
+    for k in range(vehicle.n_units - 1):
+        P = cg[k] + rot(phi[k], (vehicle.units[k].rear_coupling_m, 0.0))
+        xf, b = vehicle.units[k + 1].front_coupling_m, beta[k + 1]
+        rho = float(np.hypot(*P))
+        d = brentq(lambda d: (xf + b * d) ** 2 + d * d - rho * rho, 1e-9, 2 * rho + abs(xf) + 1.0, xtol=1e-14)
+        local = (xf + b * d, -d)
+        ph = np.arctan2(P[1], P[0]) - np.arctan2(local[1], local[0])
+        cg.append(P - rot(ph, (xf, 0.0)))
+        phi.append(ph)
+    return lambda unit, x: float(np.hypot(*(cg[unit] + rot(phi[unit], (x, 0.0)))))
+
+
+def steady_turn_newton_euler(vehicle: Vehicle, speed_mps: float, yaw_rate: float):
+    """An independent steady turn of the linear yaw-plane model: Newton-Euler for every unit with
+    the joint forces explicit (not the package's virtual-power builder), every unit at the yaw
+    rate ``yaw_rate`` and the forward speed u.  Unknowns: the CG lateral velocities v_i, the
+    articulation angles theta_k, the joint forces F_k (on unit k+1 at its front coupling, along
+    +y; minus that on unit k) and the steer delta.  Returns (v [m/s] per unit, delta [rad])."""
+    n, u, w = vehicle.n_units, float(speed_mps), float(yaw_rate)
+    nv, nth, nF = n, n - 1, n - 1
+    size = nv + nth + nF + 1
+    A, rhs = np.zeros((size, size)), np.zeros(size)
+    iv, ith, iF, idl = 0, nv, nv + nth, nv + nth + nF
+    row = 0
+    for i, unit in enumerate(vehicle.units):
+        fy, mz = np.zeros(size), np.zeros(size)      # lateral force and yaw moment about the CG, linear in unknowns
+        const_f, const_m = 0.0, 0.0
+        for a in unit.axles:
+            C, CM, CSD2 = a.cornering_stiffness_axle_N_per_rad, a.aligning_stiffness_axle_Nm_per_rad, \
+                a.dual_yaw_damping_axle_N_m2
+            # alpha = delta (steered) - (v_i + x w)/u; F = C alpha; M = -CM alpha; dual -CSD2 w / u
+            fy[iv + i] -= C / u
+            const_f -= C * a.x_m * w / u
+            mz[iv + i] -= (C * a.x_m - CM) / u
+            const_m -= (C * a.x_m - CM) * a.x_m * w / u + CSD2 * w / u
+            if a.steered:
+                fy[idl] += C
+                mz[idl] += C * a.x_m - CM
+        if i > 0:                                    # the joint force from the unit ahead, at the front coupling
+            fy[iF + i - 1] += 1.0
+            mz[iF + i - 1] += unit.front_coupling_m
+        if i < n - 1:                                # its reaction, at the rear coupling
+            fy[iF + i] -= 1.0
+            mz[iF + i] -= unit.rear_coupling_m
+        A[row], rhs[row] = fy, unit.mass_kg * u * w - const_f          # m (v' + u r) = sum F, steady
+        A[row + 1], rhs[row + 1] = mz, -const_m                        # I r' = sum M = 0, steady
+        row += 2
+    for k in range(n - 1):                            # v_(k+1) = v_k + x_r,k w - x_f,k+1 w + u theta_k
+        A[row, iv + k + 1], A[row, iv + k], A[row, ith + k] = 1.0, -1.0, -u
+        rhs[row] = (vehicle.units[k].rear_coupling_m - vehicle.units[k + 1].front_coupling_m) * w
+        row += 1
+    sol = np.linalg.solve(A, rhs)
+    return sol[iv:iv + nv], float(sol[idl])

@@ -24,6 +24,7 @@ from lcvreport.model.builder import system_coefficients
 from lcvreport.model.loads import ResidualLoads, ResidualSources
 
 from conftest import EXAMPLES
+from helpers import chain_on_circle_by_root_finding
 
 U88 = 88 / 3.6
 
@@ -196,7 +197,8 @@ def test_hsso_equals_a_long_run_holding_the_turns_steer(name):
     vel = co.velocity_map(U88) @ x
     steered = max(v.steered_axles, key=lambda a: a.x_m)
     rear = v.units[-1].rearmost_axle
-    R = lambda i, xp: math.hypot(xp + vel[i] / omega, U88 / omega)          # noqa: E731
+    # the run's sideslips, the chain placed on the circle by root finding (SPEC 12, corrected 2026-12)
+    R = chain_on_circle_by_root_finding(v, vel / U88, U88 / omega)
     assert R(v.n_units - 1, rear.x_m) - R(0, steered.x_m) == pytest.approx(turn.hsso_m, rel=1e-6)
 
 

@@ -329,7 +329,7 @@ def test_assessment_measures_table_equals_lcv_measures(assessment):
         else:
             assert float(row["value"]) == value, key          # the same number, to the last bit
         seen.add(key.split("[")[0].split(".")[0])
-    assert seen == set(doc)
+    assert seen == set(doc) - {"reasons"}            # every measure (the reasons are the rows' notes)
 
 
 @pytest.mark.xdist_group("assessment")

@@ -77,9 +77,8 @@ def test_every_row_is_measure_set_of_its_case(tmp_path):
         assert vehicle.units[5].mass_kg == pytest.approx(base.units[5].mass_kg * row["trailer3.mass_scale"],
                                                          rel=1e-15)
         assert kwargs == {"tire_scale": row["tire_scale"]}
-        doc = measure_set(vehicle, speed_mps, **kwargs).to_dict()
-        trim = doc.get("trim") or {}                    # no source in SMALL: the trim is null
-        doc["trim_delta_rad"], doc["trim_offtracking_m"] = trim.get("delta_rad"), trim.get("offtracking_m")
+        ms = measure_set(vehicle, speed_mps, **kwargs)     # no source in SMALL: the trim is null
+        doc = {m: ms.value(m) for m in SMALL["measures"]}
         for m in SMALL["measures"]:
             # where the RA peak lies: the zero of its exact slope in both (tests/test_batch.py); values to 1e-12
             # YDC: a log-ratio of peak-to-peak amplitudes, to 1e-11 (tests/test_batch.py)
@@ -184,7 +183,7 @@ def test_an_interrupted_study_loses_no_finished_chunk_and_the_rerun_completes_it
 
 BAD = [
     ({"vehicle": "nope"}, "vehicle: 'nope' is neither a preset"),
-    ({"measures": ["ra_peek"]}, "measures: 'ra_peek' is not a measure"),
+    ({"measures": ["ra_peek"]}, "measures: unknown measure 'ra_peek'"),
     ({"design": {"kind": "latin"}}, "design.kind must be grid or random"),
     ({"design": {"kind": "random", "count": 0, "seed": 1}}, "design.count must be an integer in [1, 10000000]"),
     ({"design": {"kind": "random", "count": 10}}, "design.seed must be an integer >= 0"),
@@ -339,9 +338,9 @@ def test_a_progress_bar_on_a_terminal_and_none_otherwise(tmp_path):
 
 def test_load_cases_and_residual_sources_give_measure_sets_trim(tmp_path):
     """Factors load_units (the 1 % rule on lists of units), P_/T_/eps_<axle> and crossfall_percent
-    act on the trim: each row's trim_delta_rad and trim_offtracking_m equal measure_set's trim of
+    act on the trim: each row's trim.delta_rad and trim.offtracking_m equal measure_set's trim of
     study_case (1e-12), null (NaN) where the case has no source."""
-    doc = {"vehicle": "aucnat", "speed_kph": 88.0, "measures": ["trim_delta_rad", "trim_offtracking_m", "hsso_m"],
+    doc = {"vehicle": "aucnat", "speed_kph": 88.0, "measures": ["trim.delta_rad", "trim.offtracking_m", "hsso_m"],
            "design": {"kind": "random", "count": 24, "seed": 8}, "chunk_size": 10,
            "factors": {"load_units": {"values": [["trailer3"], ["trailer2", "trailer3"], []]},
                        "P_41_N": {"values": [0.0, 800.0]}, "T_61_Nm": {"values": [0.0, -150.0]},
@@ -357,12 +356,12 @@ def test_load_cases_and_residual_sources_give_measure_sets_trim(tmp_path):
         trim = measure_set(vehicle, speed_mps, **kwargs).to_dict().get("trim")
         if trim is None:
             nulls += 1
-            assert np.isnan(row["trim_delta_rad"]) and np.isnan(row["trim_offtracking_m"])
+            assert np.isnan(row["trim.delta_rad"]) and np.isnan(row["trim.offtracking_m"])
         else:
             # sources of both signs can nearly cancel (a steer of 1.7e-9 rad from terms of ~1e-3): 1e-12
             # relative, or 1e-15 (rad, m) where the trim is ~0 -- 1e-12 of the terms it is the sum of
             for key in ("delta_rad", "offtracking_m"):
-                got, ref = row[f"trim_{key}"], trim[key]
+                got, ref = row[f"trim.{key}"], trim[key]
                 assert abs(got - ref) <= max(1e-12 * abs(ref), 1e-15), (int(row["case_id"]), key, got, ref)
     assert nulls < len(table)
 
@@ -378,5 +377,5 @@ BAD_SOURCES = [
 @pytest.mark.parametrize("factors,fragment", BAD_SOURCES, ids=[f"bad{k}" for k in range(len(BAD_SOURCES))])
 def test_bad_source_factors_are_one_line(factors, fragment):
     with pytest.raises(StudyError, match=None) as info:
-        study_from_dict({"vehicle": "aucnat", "speed_kph": 88.0, "measures": ["trim_delta_rad"], "factors": factors})
+        study_from_dict({"vehicle": "aucnat", "speed_kph": 88.0, "measures": ["trim.delta_rad"], "factors": factors})
     assert fragment in str(info.value) and "\n" not in str(info.value), str(info.value)

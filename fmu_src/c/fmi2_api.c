@@ -375,7 +375,7 @@ fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real x_nomi
 {
     BEGIN_FUNCTION(GetNominalsOfContinuousStates)
     if (!states_arg(c, "fmi2GetNominalsOfContinuousStates", x_nominal, nx)) return fmi2Error;
-    for (size_t i = 0; i < nx; ++i) x_nominal[i] = 1.0;
+    model_get_nominals(c, x_nominal, nx);     /* each state's physical scale */
     return fmi2OK;
 }
 

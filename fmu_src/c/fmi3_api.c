@@ -695,7 +695,7 @@ fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 
 {
     BEGIN(fmi3GetNominalsOfContinuousStates, PhaseInstantiated | MASK_STATES)
     if (!states_arg(c, "fmi3GetNominalsOfContinuousStates", nominals, nContinuousStates)) return fmi3Error;
-    for (size_t i = 0; i < nContinuousStates; ++i) nominals[i] = 1.0;
+    model_get_nominals(&c->m, nominals, nContinuousStates);     /* each state's physical scale */
     return fmi3OK;
 }
 

@@ -345,6 +345,12 @@ const char *model_variable_name(unsigned vr)
 
 unsigned model_me_state_vr(size_t k) { return k < LCV_N_ME_STATES ? LCV_ME_STATE_VR[k] : 0u; }
 
+void model_get_nominals(ModelInstance *c, double x[], size_t nx)
+{
+    (void)c;
+    for (size_t i = 0; i < nx && i < LCV_N_ME_STATES; ++i) x[i] = LCV_ME_NOMINAL[i];
+}
+
 void model_get_states(ModelInstance *c, double x[], size_t nx)
 {
     const LcvVehicle *v = vehicle_of(c);
@@ -547,7 +553,7 @@ static void compute_outputs(ModelInstance *c, double *out, int *valid)
     int n = v->n, m = n + 2, N = v->n_units;
     char why[1024] = "";
     int inputs_ok = -1;
-    double theta_sin[LCV_MAX_UNITS];
+    double theta_sin[LCV_MAX_UNITS] = {0};        /* a single unit has none (and gcc must see it set) */
     for (int k = 0; k < N - 1; ++k) {
         double s = 0.0;
         for (int j = 0; j < m; ++j) s += v->H[(size_t)k * m + j] * c->s.z[j];

@@ -86,6 +86,8 @@ int model_set_integer(ModelInstance *c, fmi2ValueReference vr, long long value);
 /* Model Exchange (SPEC section 15): the continuous states of the interface (v1, r.., theta..,
    psi1, Y1; 0 for what the vehicle lacks) and their derivatives at the current inputs */
 void model_get_states(ModelInstance *c, double x[], size_t nx);
+/* their nominals: each state's physical scale (the peak of the standard single sine), for a host's tolerances */
+void model_get_nominals(ModelInstance *c, double x[], size_t nx);
 void model_set_states(ModelInstance *c, const double x[], size_t nx);
 int model_derivatives(ModelInstance *c, double dx[], size_t nx);
 /* directional derivatives of derivatives and outputs with respect to states and inputs other than u */

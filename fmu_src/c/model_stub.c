@@ -56,6 +56,7 @@ int model_check_state(ModelInstance *c, const ModelState *s) { (void)c; (void)s;
 
 void model_state_restored(ModelInstance *c, int same_vehicle) { (void)c; (void)same_vehicle; }
 
+void model_get_nominals(ModelInstance *c, double x[], size_t nx) { (void)c; for (size_t i = 0; i < nx; ++i) x[i] = 1.0; }
 void model_get_states(ModelInstance *c, double x[], size_t nx) { (void)c; for (size_t i = 0; i < nx; ++i) x[i] = 0.0; }
 
 void model_set_states(ModelInstance *c, const double x[], size_t nx) { (void)c; (void)x; (void)nx; }

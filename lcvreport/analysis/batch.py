@@ -115,7 +115,10 @@ def ratio_damping_groups(group: np.ndarray, signal: np.ndarray, values: np.ndarr
     starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
     pmax = np.maximum.reduceat(P, starts)
     which = np.cumsum(np.r_[True, lab[1:] != lab[:-1]]) - 1   # index into starts
-    keep = P >= YDC_MIN_FRACTION * pmax[which]
+    idx = np.arange(P.size)
+    first_max = np.minimum.reduceat(np.where(P == pmax[which], idx, P.size), starts)
+    # the free decay starts at each signal's largest amplitude; from it on, those >= 5 % of it
+    keep = (idx >= first_max[which]) & (P >= YDC_MIN_FRACTION * pmax[which])
     rank = np.cumsum(keep)
     before = np.r_[0, rank][starts][which]                      # kept amplitudes before the signal's first
     keep &= (rank - before) <= YDC_MAX_AMPLITUDES
@@ -745,16 +748,17 @@ class VariantBatch:
                     ) -> tuple[np.ndarray, np.ndarray]:
         """(hsso_m, steer [rad]) of every variant in the steady turn of
         :func:`lcvreport.analysis.field_measures.steady_turn` (tractor yaw rate u/R)."""
-        from .field_measures import HSSO_RADIUS_M
+        from .field_measures import HSSO_RADIUS_M, chain_on_circle
         R = HSSO_RADIUS_M if radius_m is None else float(radius_m)
         u = float(speed_mps)
         omega = u / R
         v = self.vehicle
         x, delta = self._steady(u, np.zeros(v.n_states), omega, tire_scale)
-        vel = x @ system_coefficients(v).velocity_map(u).T                 # (B, N) CG lateral velocities
+        beta = x @ system_coefficients(v).velocity_map(u).T / u            # (B, N) CG sideslips
+        d = chain_on_circle(v, beta, R)                                     # (B, N) the chain on the circle
         steered = max(v.steered_axles, key=lambda a: a.x_m)
         rear = v.units[-1].rearmost_axle
-        radius = lambda unit, xp: np.hypot(xp + vel[:, unit] / omega, u / omega)  # noqa: E731
+        radius = lambda unit, xp: np.hypot(xp + beta[:, unit] * d[:, unit], d[:, unit])  # noqa: E731
         return radius(v.n_units - 1, rear.x_m) - radius(0, steered.x_m), delta
 
     def _max_real_at(self, v_kph: np.ndarray, tire_scale: float) -> np.ndarray:
@@ -779,6 +783,7 @@ class VariantBatch:
         once: the coarse 4 km/h scan, the 1 km/h scan of each variant's own doubtful intervals,
         the bisection to 0.01 km/h, rounded to 0.1 km/h."""
         from ..analysis.measures import CRITICAL_SPEED_MAX_KPH, U_MIN_DEFAULT_MPS
+        from ..ranges import RANGES
         from ..units import mps_to_kph
         u_max_kph = CRITICAL_SPEED_MAX_KPH if u_max_kph is None else u_max_kph
         lo_kph = mps_to_kph(RANGES["u_min"].check(U_MIN_DEFAULT_MPS if u_min_mps is None else u_min_mps, "u_min"))
@@ -836,28 +841,50 @@ class VariantBatch:
         S = tire_scale * (c["S0"][variants] + c["Sinv"][variants] / u) + c["Skin"][variants] + u * c["Su"][variants]
         return np.linalg.eigvals(solve_scaled(M, S)).real.max(axis=-1)
 
-    def measures(self, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None, F=None):
-        """The batched measures of every variant as columns (a dict of arrays of length B, ready
-        for ``pandas.DataFrame``): a ``case_id``, one column per varied parameter and the measures
-        under the keys of ``lcv measures --json`` (``trim_delta_rad``, ``trim_offtracking_m`` with
-        ``F``); NaN where a measure is undefined (no oscillatory mode, stable to 200 km/h)."""
+    def measure_group(self, name: str, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None,
+                      F=None) -> tuple:
+        """The arrays of one group of :data:`lcvreport.analysis.registry.BATCHED` (``name``: the
+        method), in the order of its keys.  ``F`` (B, 2N) is every variant's generalized force of
+        its residual sources (the trim's; NaN rows: none)."""
         from .measures import RA_FREQUENCY_HZ
         f_hz = RA_FREQUENCY_HZ if f_hz is None else f_hz
-        zeta, f_zeta = self.least_damping(speed_mps, tire_scale)
-        crit = self.critical_speed(tire_scale)
-        peak, peak_f = self.ra_peak(speed_mps, tire_scale)
-        hsso, turn_delta = self.steady_turn(speed_mps, tire_scale)
-        hsto, ra_lc = self.lane_change(speed_mps, tire_scale)
+        if name == "critical_speed":
+            return (self.critical_speed(tire_scale),)
+        if name == "rearward_amplification":
+            return (self.rearward_amplification(speed_mps, f_hz, tire_scale),)
+        if name == "single_sine":
+            return (self.single_sine(speed_mps, f_hz, tire_scale),)
+        if name == "yaw_damping":
+            from .field_measures import YDC_HEAVY_ZETA
+            zeta = self.yaw_damping(speed_mps, tire_scale)
+            bound = np.where(np.isnan(zeta) & (self.vehicle.n_units > 1), YDC_HEAVY_ZETA, np.nan)
+            return zeta, bound
+        if name == "trim":
+            if F is None:
+                return np.full(self.size, np.nan), np.full(self.size, np.nan)
+            F = np.asarray(F, dtype=float)
+            out = (np.full(len(F), np.nan), np.full(len(F), np.nan))
+            has = np.isfinite(F[:, 0])
+            if has.any():                       # a batch of one variant under several forces: one row each
+                rows = np.flatnonzero(has) if self.size > 1 else np.zeros(int(has.sum()), int)
+                out[0][has], out[1][has] = self._subset(rows).trim(speed_mps, F[has], tire_scale)
+            return out
+        result = getattr(self, name)(speed_mps, tire_scale)
+        return tuple(result)
+
+    def measures(self, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None, F=None):
+        """The batched measures of every variant as columns (a dict of arrays of length B, ready
+        for ``pandas.DataFrame``): a ``case_id``, one column per varied parameter and every
+        measure of :data:`lcvreport.analysis.registry.BATCHED` under its registry key (the trim's,
+        ``trim.delta_rad`` and ``trim.offtracking_m``, with ``F``); NaN where a measure is
+        undefined (no oscillatory mode, stable to 200 km/h)."""
+        from .registry import BATCHED
         table = {"case_id": np.arange(self.size)}
         table.update({name: np.asarray(arr, dtype=float) for name, arr in self.values.items()})
-        table.update({"speed_mps": np.full(self.size, float(speed_mps)), "least_damping_ratio": zeta,
-                      "least_damped_frequency_hz": f_zeta, "critical_speed_kph": crit,
-                      "ra_frequency": self.rearward_amplification(speed_mps, f_hz, tire_scale),
-                      "ra_single_sine": self.single_sine(speed_mps, f_hz, tire_scale),
-                      "yaw_damping_coefficient": self.yaw_damping(speed_mps, tire_scale),
-                      "hsto_m": hsto, "ra_lane_change": ra_lc,
-                      "ra_peak": peak, "ra_peak_frequency_hz": peak_f, "hsso_m": hsso,
-                      "steady_turn_delta_rad": turn_delta})
-        if F is not None:
-            table["trim_delta_rad"], table["trim_offtracking_m"] = self.trim(speed_mps, F, tire_scale)
+        table["speed_mps"] = np.full(self.size, float(speed_mps))
+        for group, keys in BATCHED.items():
+            if group == "trim" and F is None:
+                continue
+            for key, arr in zip(keys, self.measure_group(group, speed_mps, tire_scale, f_hz, F)):
+                table[key] = np.asarray(arr, dtype=float)
         return table

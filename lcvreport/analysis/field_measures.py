@@ -41,6 +41,10 @@ YDC_WINDOW_S = 40.0
 #: amplitudes kept: at least this fraction of the joint's largest, the first this many
 YDC_MIN_FRACTION = 0.05
 YDC_MAX_AMPLITUDES = 6
+#: a joint with fewer than two kept amplitudes decays faster than 1/YDC_MIN_FRACTION per half
+#: cycle: its zeta is at least this (ln 20 / sqrt(pi^2 + ln^2 20) = 0.6901), the YDC's lower bound
+#: when every joint is so (SPEC 12)
+YDC_HEAVY_ZETA = math.log(1.0 / YDC_MIN_FRACTION) / math.sqrt(math.pi ** 2 + math.log(1.0 / YDC_MIN_FRACTION) ** 2)
 #: the lane change of HSTO: A0 [g], F [Hz], time after it [s]
 LANE_CHANGE = (0.15, 0.4)
 LANE_CHANGE_TAIL_S = 8.0
@@ -150,6 +154,10 @@ class YawDamping:
     response : ManoeuvreResponse
     why : str
         Why ``value`` is None.
+    lower_bound : float or None
+        When every joint is heavily damped (fewer than two kept amplitudes: a decay faster
+        than x20 per half cycle), the bound ``YDC_HEAVY_ZETA`` = 0.6901 its value is at least;
+        None otherwise.
     """
 
     value: float | None
@@ -159,14 +167,17 @@ class YawDamping:
     modal_least_damping_ratio: float | None
     response: ManoeuvreResponse
     why: str = ""
+    lower_bound: float | None = None
 
 
 def ratio_damping(extrema_values) -> tuple[float | None, np.ndarray]:
     """The ratio method on a signal's successive extrema (time order): the peak-to-peak
-    amplitudes P_i = |A_(i+1) - A_i|, the first six of those >= 5 % of the largest, and
-    the mean over consecutive pairs of zeta = d / sqrt(pi^2 + d^2), d = ln(P_i/P_(i+1));
-    None when fewer than two amplitudes are kept.  For one damped mode
-    ``exp(sigma t) sin(omega t)`` it is exactly -sigma / |lambda|.
+    amplitudes P_i = |A_(i+1) - A_i|; the free decay starts at the largest (the amplitudes
+    before it are the forced response); from it on, those >= 5 % of it (a smaller one is
+    skipped, later ones still count), the first six; the mean over consecutive pairs of kept
+    amplitudes of zeta = d / sqrt(pi^2 + d^2), d = ln(P_i/P_(i+1)); None when fewer than two are
+    kept (SPEC 12, corrected 2026-12).  For one damped mode ``exp(sigma t) sin(omega t)`` it is
+    exactly -sigma / |lambda|.
 
     Examples
     --------
@@ -179,7 +190,8 @@ def ratio_damping(extrema_values) -> tuple[float | None, np.ndarray]:
     v = np.asarray(extrema_values, dtype=float)
     P = np.abs(np.diff(v))
     if P.size:
-        P = P[P >= YDC_MIN_FRACTION * P.max()][:YDC_MAX_AMPLITUDES]
+        P = P[int(np.argmax(P)):]                  # the free decay starts at the largest amplitude
+        P = P[P >= YDC_MIN_FRACTION * P[0]][:YDC_MAX_AMPLITUDES]
     if P.size < 2:
         return None, P
     d = np.log(P[:-1] / P[1:])
@@ -205,7 +217,7 @@ def _yaw_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float, zeta_mod
     t_end = round((D + YDC_WINDOW_S) / YDC_DT_S) * YDC_DT_S
     r = response(vehicle, speed_mps, steer, t_end, YDC_DT_S, tire_scale=tire_scale)
     if vehicle.n_units < 2:
-        return YawDamping(None, [], [], [], zeta_modal, r, "a single unit has no articulation joint")
+        return YawDamping(None, [], [], [], zeta_modal, r, "no joint: a single unit has no articulation angle")
     per_joint, amps, ext = [], [], []
     for t, v in r.extrema_many(vehicle.state_names[vehicle.n_units + 1:], D, D + YDC_WINDOW_S):
         inner = (t > D + 1e-12) & (t < D + YDC_WINDOW_S - 1e-12)     # the window's ends are not extrema
@@ -217,7 +229,9 @@ def _yaw_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float, zeta_mod
     defined = [z for z in per_joint if z is not None]
     if not defined:
         return YawDamping(None, per_joint, amps, ext, zeta_modal, r,
-                          "no joint oscillates with two amplitudes of at least 5 % of its largest after the pulse")
+                          f"heavily damped: no joint has two peak-to-peak amplitudes of at least 5 % of its "
+                          f"largest after the pulse (a decay faster than x20 per half cycle), so YDC >= "
+                          f"{YDC_HEAVY_ZETA:.4f}", YDC_HEAVY_ZETA)
     return YawDamping(min(defined), per_joint, amps, ext, zeta_modal, r)
 
 
@@ -261,27 +275,88 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
 
 @dataclass(frozen=True)
 class SteadyTurn:
-    """The steady turn of HSSO (SPEC section 12)."""
+    """The steady turn of HSSO (SPEC section 12, as corrected 2026-12).
+
+    Attributes
+    ----------
+    hsso_m : float
+        Path radius of the last unit's rearmost axle minus that of the frontmost steered axle [m]
+        (positive: the rear tracks outside).
+    delta_rad : float
+        The steer that holds the turn [rad].
+    radius_m : float
+        R: the tractor's yaw rate is u/R [m].
+    state : numpy.ndarray
+        The steady state x.
+    path_radius_m : dict
+        Axle name -> the radius of its centre's path about the turn centre [m].
+    sideslip_rad : numpy.ndarray, shape (N,)
+        beta_i = v_i/u of every unit's CG.
+    axis_distance_m : numpy.ndarray, shape (N,)
+        d_i: the distance from the turn centre to every unit's axis line [m] (d_1 = R).
+    """
 
     hsso_m: float
     delta_rad: float
     radius_m: float
     state: np.ndarray
     path_radius_m: dict
+    sideslip_rad: np.ndarray = None
+    axis_distance_m: np.ndarray = None
+
+
+def chain_on_circle(vehicle: Vehicle, beta, radius_m: float) -> np.ndarray:
+    r"""Distances d_i [m] from the turn centre O to every unit's axis line, for units turning
+    about one centre with CG sideslips ``beta`` (shape (..., N)): in unit i's frame O lies at
+    (-beta_i d_i, d_i); d_1 = R; the coupling k (x = rear_coupling_m on unit k, front_coupling_m
+    on unit k+1) is one point, so it has one radius,
+
+    .. math:: (x_{r,k} + \beta_k d_k)^2 + d_k^2 = (x_{f,k+1} + \beta_{k+1} d_{k+1})^2 + d_{k+1}^2,
+
+    which gives d_(k+1) (the positive root).  Broadcasts over a leading axis (variants).
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> import numpy as np
+    >>> v = load_preset("tractor_semitrailer")
+    >>> d = chain_on_circle(v, np.zeros(2), 393.0)      # no sideslip: the fifth wheel has one radius
+    >>> xr, xf = v.units[0].rear_coupling_m, v.units[1].front_coupling_m
+    >>> bool(abs(np.hypot(xr, d[0]) - np.hypot(xf, d[1])) < 1e-9)
+    True
+    """
+    beta = np.asarray(beta, dtype=float)
+    d = np.empty(beta.shape)
+    d[..., 0] = radius_m
+    for k in range(vehicle.n_units - 1):
+        xr, xf = vehicle.units[k].rear_coupling_m, vehicle.units[k + 1].front_coupling_m
+        rho2 = (xr + beta[..., k] * d[..., k]) ** 2 + d[..., k] ** 2
+        b = beta[..., k + 1]
+        d[..., k + 1] = (-xf * b + np.sqrt((1.0 + b * b) * rho2 - xf * xf)) / (1.0 + b * b)
+    return d
 
 
 def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
                 radius_m: float = HSSO_RADIUS_M) -> SteadyTurn:
-    """The steady turn with the tractor's yaw rate u/R: the steady state of
-    ``M x' = S x + b delta`` with r1 = u/R; every unit turns at Omega = u/R; a point at x on
-    unit i runs on the radius sqrt((x + v_i/Omega)^2 + (u/Omega)^2).  hsso_m = the radius
-    of the last unit's rearmost axle minus that of the frontmost steered axle (positive:
-    the rear tracks outside).
+    """The steady turn with the tractor's yaw rate u/R (SPEC section 12, corrected 2026-12): the
+    steady state of ``M x' = S x + b delta`` with r1 = u/R gives every unit's CG sideslip
+    beta_i = v_i/u; every unit turns at Omega = u/R about one centre O, the units' geometry
+    chained through their shared couplings (:func:`chain_on_circle`); a point at x on unit i runs
+    on R_P = sqrt((x + beta_i d_i)^2 + d_i^2).  hsso_m = R_P of the last unit's rearmost axle
+    minus R_P of the frontmost steered axle (positive: the rear tracks outside).  As u -> 0 it is
+    the kinematic offtracking -(sum L_i^2 - sum k_i^2 - e_N^2) / (2R) to first order in 1/R.
 
     Raises
     ------
     ManoeuvreError
         No steered axle.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> t = steady_turn(load_preset("tractor_semitrailer"), 0.5)      # walking pace: kinematic
+    >>> bool(-1.0 < t.hsso_m < 0.0)                                  # the trailer tracks inside
+    True
     """
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
@@ -291,16 +366,17 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
     u = float(speed_mps)
     omega = u / radius_m
     x, delta = steady_with_yaw_rate(vehicle, u, np.zeros(vehicle.n_states), omega, tire_scale)
-    v = co.velocity_map(u) @ x                 # CG lateral velocity of every unit
+    beta = (co.velocity_map(u) @ x) / u             # CG sideslip of every unit
+    d = chain_on_circle(vehicle, beta, radius_m)
 
     def radius(unit, xp):
-        return math.hypot(xp + v[unit] / omega, u / omega)
+        return math.hypot(xp + beta[unit] * d[unit], d[unit])
 
     steered = max(vehicle.steered_axles, key=lambda a: a.x_m)
     rear = vehicle.units[-1].rearmost_axle
     paths = {a.name: radius(i, a.x_m) for i, a in zip(vehicle.axle_units, vehicle.axles)}
     hsso = radius(vehicle.n_units - 1, rear.x_m) - radius(0, steered.x_m)
-    return SteadyTurn(float(hsso), delta, float(radius_m), x, paths)
+    return SteadyTurn(float(hsso), delta, float(radius_m), x, paths, beta, d)
 
 
 def point_path(vehicle: Vehicle, response: ManoeuvreResponse, unit: int, x_m: float) -> np.ndarray:

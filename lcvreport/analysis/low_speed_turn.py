@@ -1,39 +1,47 @@
-"""The low-speed 90-degree turn and its measures (SPEC section 16), on the kinematic model
-of :mod:`lcvreport.model.low_speed`.
+"""The low-speed turn and its measures (SPEC section 16, corrected 2026-12), on the kinematic
+model of :mod:`lcvreport.model.low_speed`.
 
-The combination runs straight and aligned up to the turn; the **outside wheel of the
-steered axle** then runs on a circle of ``radius_m`` (12.5 m) through ``angle_deg`` (90)
--- the axle centre at radius - track/2 -- and a straight exit of 3 overall lengths lets
-every unit realign.  The turn is to the left; the measures are the same to the right.
+The combination runs straight and aligned up to the turn; the **outside wheel of the frontmost
+steered axle** then runs on a circle of ``radius_m`` (12.5 m) through ``angle_deg`` (90; any
+angle in (0, 3600]), then a straight exit of 3 overall lengths lets every unit realign.  Unit
+1 is pulled at that wheel (the axle is not radial while the tractor yaws, so its centre runs
+on a larger radius than radius - track/2).  The turn is to the left; the measures are the
+same to the right.
+
+A position counts for the measures while its angle about the arc's centre -- **unwrapped
+continuously** from the approach, 0 where the arc starts -- lies in [0, angle]: on a turn past
+180 or 360 degrees nothing is lost or counted twice, and the exit never counts.  An extreme on
+the sector's edge is located on the edge (the crossing found to 1e-12 m of path), an extreme
+inside it on the integrator's dense output (bounded scalar minimization).
 
 Measures [m]:
 
 ``lssp_m``
     swept width: the largest distance from the arc's centre reached by any body corner or
-    outside wheel, less the smallest reached by any point of a body's inner side or an
-    inside wheel, counting positions within the arc's sector;
+    outside wheel, less the smallest reached by any point of a body's inner side or an inside
+    wheel, within the sector;
 ``low_speed_offtracking_m``
-    the steered axle centre's path radius less the smallest radius of the last unit's
-    rearmost axle centre within the sector;
+    the largest radius of the steered axle centre's path less the smallest radius of the last
+    unit's rearmost axle centre, within the sector (on a long arc: the steady offtracking);
 ``tail_swing_m``
-    per unit, the largest outward displacement of its rear outer body corner beyond the
-    straight line it ran on before the turn (0 if it never crosses it); ``max_tail_swing_m``
+    per unit, the largest outward displacement of its rear outer body corner beyond the straight
+    line it ran on before the turn (0 if it never crosses it), while the unit has turned less
+    than a quarter turn (after that its approach line is no longer beside it); ``max_tail_swing_m``
     the largest;
 ``frontal_swing_m``
-    the largest distance of unit 1's front outer body corner outside the outside steer
-    wheel's circle, within the sector.
+    the largest distance of unit 1's front outer body corner outside the outside steer wheel's
+    circle, within the sector.
 
-A wheel is the centre of the outermost tire (track_width_m / 2 from the axle centre).
-Positions are sampled every :data:`SAMPLE_M` of path and each extreme refined on the
-integrator's dense output (bounded scalar minimization), so the measures carry the
-integration's accuracy, not the sampling's.
+A measure no position defines (a turn so tight that the last axle passes round the arc's centre
+and never enters the sector) is None, with the reason in ``undefined``.  A wheel is the centre
+of the outermost tire (track_width_m / 2 from the axle centre).
 
 Examples
 --------
 >>> from lcvreport import load_vehicle
 >>> t = low_speed_turn(load_vehicle("examples/vehicles/b_double.toml"))
 >>> round(t.lssp_m, 2), round(t.low_speed_offtracking_m, 2)
-(9.03, 6.04)
+(9.07, 6.07)
 """
 from __future__ import annotations
 
@@ -52,6 +60,9 @@ ANGLE_DEG = 90.0
 EXIT_LENGTHS = 3.0
 #: sampling of the path for the extremes [m] (each extreme then refined)
 SAMPLE_M = 0.05
+#: the largest articulation a turn's measures are given for [rad]: beyond a quarter turn between two
+#: units the trailer jackknifes (couplings stop at 70-90 deg), and the vehicle cannot make the turn
+JACKKNIFE_RAD = math.pi / 2
 
 
 class TurnError(ValueError):
@@ -106,34 +117,39 @@ def check_turn_geometry(vehicle: Vehicle) -> None:
 
 @dataclass(frozen=True)
 class LowSpeedTurn:
-    """A low-speed turn and its measures [m] (SPEC section 16)."""
+    """A low-speed turn and its measures [m] (SPEC section 16); a None measure has its reason in
+    ``undefined``."""
 
     vehicle: Vehicle
     radius_m: float
     angle_deg: float
-    lssp_m: float
-    low_speed_offtracking_m: float
+    lssp_m: float | None
+    low_speed_offtracking_m: float | None
     tail_swing_m: dict
-    frontal_swing_m: float
+    frontal_swing_m: float | None
     overall_length_m: float
     run: KinematicRun = field(repr=False)
     where: dict = field(repr=False, default_factory=dict)
+    undefined: dict = field(default_factory=dict)
 
     @property
-    def max_tail_swing_m(self) -> float:
-        return max(self.tail_swing_m.values())
+    def max_tail_swing_m(self) -> float | None:
+        return max(self.tail_swing_m.values()) if self.tail_swing_m else None
 
     @property
-    def steer_axle_radius_m(self) -> float:
-        """Radius of the steered axle centre's path [m]."""
-        return self.run.path.radius_m
+    def steer_axle_radius_m(self) -> float | None:
+        """The largest radius of the steered axle centre's path in the sector [m] (the steady
+        radius on a long arc; the outside wheel runs on ``radius_m``); None with the measures."""
+        r = self.where.get("steer_axle_radius_m", math.nan)
+        return None if not math.isfinite(r) else r
 
     def to_dict(self) -> dict:
-        """The JSON of ``lcv turn`` (SI)."""
+        """The JSON of ``lcv turn`` (SI); ``reasons`` names why a null measure is null."""
         return {"radius_m": self.radius_m, "angle_deg": self.angle_deg, "lssp_m": self.lssp_m,
                 "low_speed_offtracking_m": self.low_speed_offtracking_m, "tail_swing_m": dict(self.tail_swing_m),
                 "max_tail_swing_m": self.max_tail_swing_m, "frontal_swing_m": self.frontal_swing_m,
-                "overall_length_m": self.overall_length_m, "steer_axle_radius_m": self.steer_axle_radius_m}
+                "overall_length_m": self.overall_length_m, "steer_axle_radius_m": self.steer_axle_radius_m,
+                "reasons": dict(self.undefined)}
 
     def rows(self) -> list[dict]:
         """The measures as a table."""
@@ -144,6 +160,40 @@ class LowSpeedTurn:
         rows += [{"measure": f"tail swing of {name}", "json_key": f"tail_swing_m.{name}", "value_m": val}
                  for name, val in self.tail_swing_m.items()]
         return rows
+
+    def envelope(self, bins: int = 90) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The swept region within the turn's sector: (angles about the arc's centre [rad], the
+        least and the largest radius reached in each of ``bins`` equal bins of angle [m]) -- every
+        body corner, side and wheel, sampled along the path; a turn past 360 degrees is folded
+        onto one lap.  What the swept-path figure draws (the drawing computes nothing)."""
+        v, run = self.vehicle, self.run
+        s = np.linspace(0.0, run.path.s_end, 1500 + int(run.path.s_end / 0.5))
+        centre = run.path.centre
+        angle = math.radians(self.angle_deg)
+        edges = np.linspace(0.0, min(angle, 2 * math.pi), bins + 1)
+        r_min, r_max = np.full(bins, np.inf), np.full(bins, -np.inf)
+        for k, u in enumerate(v.units):
+            cx, cy = corners(v, k)
+            xs = np.concatenate([cx, np.linspace(u.body_front_m, u.body_rear_m, 12),
+                                 np.linspace(u.body_front_m, u.body_rear_m, 12)])
+            ys = np.concatenate([cy, np.full(12, u.body_width_m / 2), np.full(12, -u.body_width_m / 2)])
+            for a in u.axles:
+                xs = np.append(xs, [a.x_m, a.x_m])
+                ys = np.append(ys, [a.track_width_m / 2, -a.track_width_m / 2])
+            pts = run.unit_points(s, k, xs, ys)                              # (n_s, n_pts, 2)
+            phi = _unwrapped(pts, centre, run.headings(s)[:, k])
+            r = np.hypot(pts[..., 0] - centre[0], pts[..., 1] - centre[1])
+            inside = (phi >= 0) & (phi <= angle)
+            folded = np.where(angle > 2 * math.pi, np.mod(phi, 2 * math.pi), phi)
+            idx = np.clip(np.digitize(folded, edges) - 1, 0, bins - 1)
+            for b in range(bins):
+                sel = inside & (idx == b)
+                if sel.any():
+                    r_min[b] = min(r_min[b], r[sel].min())
+                    r_max[b] = max(r_max[b], r[sel].max())
+        mid = 0.5 * (edges[1:] + edges[:-1])
+        found = np.isfinite(r_min)
+        return mid[found], r_min[found], r_max[found]
 
     def plot(self, title: str | None = None, outlines_every_m: float = 2.0):
         """The swept path seen from above, to scale (:func:`lcvreport.report.plotting.fig_swept_path`)."""
@@ -160,39 +210,101 @@ def corners(vehicle: Vehicle, k: int) -> tuple[np.ndarray, np.ndarray]:
     return np.array([u.body_front_m, u.body_front_m, u.body_rear_m, u.body_rear_m]), np.array([h, -h, -h, h])
 
 
-def _sector_mask(points: np.ndarray, centre: np.ndarray, angle_rad: float) -> np.ndarray:
-    """Points whose direction from the arc's centre is within the turn's sector."""
+def _raw_angle(points: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """Angle of points about the arc's centre, 0 at the arc's start, growing with the turn (in (-pi, pi])."""
     rel = points - centre
-    phi = np.arctan2(rel[..., 0], -rel[..., 1])          # 0 at the turn's start, growing with the turn
-    if angle_rad >= 2 * math.pi:
-        return np.ones(phi.shape, dtype=bool)
-    return (phi >= -1e-12) & (phi <= angle_rad + 1e-12)
+    return np.arctan2(rel[..., 0], -rel[..., 1])
 
 
-def _refine(fun, s_grid: np.ndarray, values: np.ndarray, k: int, sign: float) -> tuple[float, float]:
-    """Refine the extreme of ``fun`` near sample ``k`` (sign +1: maximum, -1: minimum) on the
-    dense output; the sample itself where a neighbour is outside the sector or the path."""
-    from scipy.optimize import minimize_scalar
-    if 0 < k < len(s_grid) - 1 and np.isfinite(values[k - 1]) and np.isfinite(values[k + 1]):
-        res = minimize_scalar(lambda s: -sign * fun(s), bounds=(s_grid[k - 1], s_grid[k + 1]), method="bounded",
-                              options={"xatol": 1e-9})
-        if np.isfinite(res.fun) and sign * (-sign * res.fun) >= sign * values[k]:
-            return float(-sign * res.fun), float(res.x)
-    return float(values[k]), float(s_grid[k])
+def _unwrapped(points: np.ndarray, centre: np.ndarray, heading) -> np.ndarray:
+    """The angle of points of one unit about the arc's centre, unwrapped with the turn: of the
+    values of the angle (2 pi apart), the one nearest the unit's heading (its own turning from
+    the approach, continuous and growing with the turn).  For a point going round the centre
+    with the turn this is its continuous unwrapping from the approach; a point of a unit that
+    cuts inside so far that its path does not enclose the centre (a long trailer on a tight
+    circle) is still counted by how far the unit has turned, so it never re-enters the sector
+    from the exit straight.  ``heading`` broadcasts against the points' leading axes."""
+    raw = _raw_angle(points, centre)
+    h = np.asarray(heading, dtype=float)
+    h = h.reshape(h.shape + (1,) * (raw.ndim - h.ndim))
+    return raw + 2 * np.pi * np.round((h - raw) / (2 * np.pi))
+
+
+@dataclass
+class _Probe:
+    """One point of the vehicle followed along the path: ``points(s)`` -> (len(s), 2) world
+    positions; ``heading(s)`` its unit's heading [rad], which fixes how its angle about the
+    arc's centre is unwrapped."""
+
+    name: str
+    points: object
+    heading: object
+
+
+def _extreme(probe: _Probe, value, sign: float, s: np.ndarray, centre: np.ndarray, lo: float, hi: float):
+    """The largest (``sign`` +1) or smallest (-1) of ``value(points)`` over the positions of
+    ``probe`` whose unwrapped angle lies in [lo, hi]: interior extremes refined on the dense
+    output, extremes on the sector's edges located on the edge.  None if no position is in it.
+
+    Returns
+    -------
+    (value, s) or None
+    """
+    from scipy.optimize import brentq, minimize_scalar
+    pts = probe.points(s)
+    phi = _unwrapped(pts, centre, probe.heading(s))
+    vals = value(pts)
+    inside = (phi >= lo) & (phi <= hi)
+    if not inside.any():
+        return None
+
+    def phi_at(x, _k=None):
+        xs = np.array([x])
+        return float(_unwrapped(probe.points(xs), centre, probe.heading(xs))[0])
+
+    def val_at(x):
+        return float(value(probe.points(np.array([x])))[0])
+
+    best = None
+
+    def offer(v, x):
+        nonlocal best
+        if best is None or sign * v > sign * best[0]:
+            best = (v, x)
+    k = np.flatnonzero(inside)
+    runs = np.split(k, np.flatnonzero(np.diff(k) > 1) + 1)
+    for run in runs:
+        i0, i1 = int(run[0]), int(run[-1])
+        j = i0 + int(np.argmax(sign * vals[i0:i1 + 1]))
+        offer(float(vals[j]), float(s[j]))
+        if i0 < j < i1:                              # inside the sector: refine between the neighbours
+            res = minimize_scalar(lambda x: -sign * val_at(x), bounds=(s[j - 1], s[j + 1]), method="bounded",
+                                  options={"xatol": 1e-9})
+            if np.isfinite(res.fun) and lo <= phi_at(res.x, j) <= hi:
+                offer(-sign * float(res.fun), float(res.x))
+        for a, b, inner in ((i0 - 1, i0, i0), (i1, i1 + 1, i1)):      # the edges the run crosses
+            if a < 0 or b >= s.size:
+                continue
+            out = a if inner == b else b
+            edge = lo if phi[out] < lo else hi
+            x = brentq(lambda x: phi_at(x, inner) - edge, s[a], s[b], xtol=1e-12)
+            offer(val_at(x), x)
+    return best
 
 
 def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
                    rtol: float = 1e-10, atol: float = 1e-12) -> LowSpeedTurn:
-    """The low-speed turn of ``vehicle`` and its measures.
+    """The low-speed turn of ``vehicle`` and its measures (SPEC section 16, corrected 2026-12).
 
     Parameters
     ----------
     vehicle : Vehicle
         With every unit's body keys and every axle's track width (SPEC section 16).
     radius_m : float
-        Radius of the outside steer wheel's path [m], in (track/2, 100].
+        Radius of the outside steer wheel's path [m], in (track/2, 100] (the ranges table's
+        ``turn_radius``, and more than half the steered axle's track).
     angle_deg : float
-        Angle of the turn [deg], in (0, 360].
+        Angle of the turn [deg], in the ranges table's ``turn_angle``: (0, 3600].
     rtol, atol : float
         Tolerances of the heading integration.
 
@@ -203,106 +315,123 @@ def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: floa
     Raises
     ------
     TurnError
-        Missing or invalid geometry, a radius the steered axle cannot follow.
+        Missing or invalid geometry, a radius or an angle out of range.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> t = low_speed_turn(load_preset("tractor_semitrailer"), angle_deg=270.0)
+    >>> bool(t.lssp_m < 10.0)                       # the exit straight never counts
+    True
     """
+    from ..ranges import RANGES
     check_turn_geometry(vehicle)
-    if not (math.isfinite(angle_deg) and 0 < angle_deg <= 3600):
-        raise TurnError(f"angle_deg must be in (0, 3600], got {angle_deg!r}")
+    for key, value, name in (("turn_angle", angle_deg, "angle_deg"), ("turn_radius", radius_m, "radius_m")):
+        r = RANGES[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not r.contains(float(value)):
+            raise TurnError(f"{name} must be in {r.text()} ({r.description}), got {value!r}")
     u1 = vehicle.units[0]
     steer = max((a for a in u1.axles if a.steered), key=lambda a: a.x_m)
     half_track = steer.track_width_m / 2
-    if not (math.isfinite(radius_m) and half_track < radius_m <= 100.0):
+    if not radius_m > half_track:
         raise TurnError(f"radius must be in ({half_track:g}, 100] m (the outside wheel of axle {steer.name} is "
                         f"{half_track:g} m from its centre), got {radius_m!r}")
     length = overall_length_m(vehicle)
     angle = math.radians(angle_deg)
-    R_axle = radius_m - half_track
-    path = StraightArcPath(R_axle, angle, EXIT_LENGTHS * length)
-    run = integrate(vehicle, path, np.zeros(vehicle.n_units), rtol, atol)
+    path = StraightArcPath(radius_m, angle, EXIT_LENGTHS * length)          # the outside wheel's path
+    run = integrate(vehicle, path, np.zeros(vehicle.n_units), rtol, atol, pull_offset_m=-half_track)
     centre = path.centre
     n_s = max(int(math.ceil(path.s_end / SAMPLE_M)), 200) + 1
     s = np.linspace(0.0, path.s_end, n_s)
+    if vehicle.n_units > 1:                      # a jackknife: the turn is beyond the vehicle
+        art = np.abs(np.diff(run.headings(s), axis=1))
+        k, j = np.unravel_index(int(np.argmax(art)), art.shape)
+        if art[k, j] > JACKKNIFE_RAD:
+            why = (f"joint {j + 1} ({vehicle.units[j].name}-{vehicle.units[j + 1].name}) articulates to "
+                   f"{math.degrees(art[k, j]):.0f} deg in this turn (beyond {math.degrees(JACKKNIFE_RAD):.0f} deg: a "
+                   f"jackknife): {vehicle.name} cannot make a {angle_deg:g} deg turn with its outside steer wheel on "
+                   f"{radius_m:g} m")
+            undefined = {key: why for key in ("lssp_m", "low_speed_offtracking_m", "frontal_swing_m",
+                                              "max_tail_swing_m")}
+            return LowSpeedTurn(vehicle, float(radius_m), float(angle_deg), None, None, {}, None, float(length), run,
+                                {"steer_axle_radius_m": math.nan}, undefined)
 
     def radius(points):
         return np.hypot(points[..., 0] - centre[0], points[..., 1] - centre[1])
 
-    # the outermost and innermost things at every sample, with what reached them
-    outer_fns, inner_fns = [], []
+    def point(k, x, y):
+        return lambda ss: run.unit_points(ss, k, [x], [y])[:, 0]
+
+    def heading(k):
+        return lambda ss: run.headings(np.atleast_1d(ss)).reshape(np.size(ss), -1)[:, k]
+
+    # what reaches outward (body corners, outside wheels) and inward (inner sides, inside wheels)
+    outer, inner = [], []
     for k, u in enumerate(vehicle.units):
         cx, cy = corners(vehicle, k)
-        outer_fns.append((f"{u.name} body corners", lambda ss, k=k, cx=cx, cy=cy: run.unit_points(ss, k, cx, cy)))
+        outer += [_Probe(f"{u.name} body corner {j}", point(k, cx[j], cy[j]), heading(k)) for j in range(4)]
         for a in u.axles:
             h = a.track_width_m / 2
-            outer_fns.append((f"{u.name} axle {a.name} outside wheel",
-                              lambda ss, k=k, x=a.x_m, h=h: run.unit_points(ss, k, [x], [-h])))
-            inner_fns.append((f"{u.name} axle {a.name} inside wheel",
-                              lambda ss, k=k, x=a.x_m, h=h: run.unit_points(ss, k, [x], [h]), None))
-        inner_fns.append((f"{u.name} body inner side",
-                          lambda ss, k=k, u=u: run.unit_points(ss, k, [u.body_front_m, u.body_rear_m],
-                                                               [u.body_width_m / 2] * 2), "segment"))
+            outer.append(_Probe(f"{u.name} axle {a.name} outside wheel", point(k, a.x_m, -h), heading(k)))
+            inner.append(_Probe(f"{u.name} axle {a.name} inside wheel", point(k, a.x_m, h), heading(k)))
 
-    def outer_value(fn, ss):
-        pts = fn(np.atleast_1d(ss))
-        r = np.where(_sector_mask(pts, centre, angle), radius(pts), -np.inf)
-        return r.max(axis=1)
-
-    def inner_value(fn, kind, ss):
-        pts = fn(np.atleast_1d(ss))
-        if kind == "segment":              # the closest point of the side to the centre
-            a, b = pts[:, 0], pts[:, 1]
+        def side(ss, k=k, u=u):                  # the point of the inner side closest to the centre
+            ends = run.unit_points(ss, k, [u.body_front_m, u.body_rear_m], [u.body_width_m / 2] * 2)
+            a, b = ends[:, 0], ends[:, 1]
             ab = b - a
             t = np.clip(np.einsum("ij,ij->i", centre - a, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
-            pts = (a + t[:, None] * ab)[:, None, :]
-        r = np.where(_sector_mask(pts, centre, angle), radius(pts), np.inf)
-        return r.min(axis=1)
-
-    best_out, where_out = -np.inf, ""
-    for name, fn in outer_fns:
-        vals = outer_value(fn, s)
-        k = int(np.argmax(vals))
-        if np.isfinite(vals[k]):
-            val, _ = _refine(lambda x: float(outer_value(fn, x)[0]), s, vals, k, +1.0)
-            if val > best_out:
-                best_out, where_out = val, name
-    best_in, where_in = np.inf, ""
-    for name, fn, kind in inner_fns:
-        vals = inner_value(fn, kind, s)
-        k = int(np.argmin(vals))
-        if np.isfinite(vals[k]):
-            val, _ = _refine(lambda x: float(inner_value(fn, kind, x)[0]), s, vals, k, -1.0)
-            if val < best_in:
-                best_in, where_in = val, name
-    # low-speed offtracking: the last unit's rearmost axle centre
+            return a + t[:, None] * ab
+        inner.append(_Probe(f"{u.name} body inner side", side, heading(k)))
+    undefined = {}
+    never = ("no position of {what} lies in the turn's sector (0 to {angle:g} deg about the arc's centre): a turn "
+             "this tight takes it round the centre, or one this short ends before it arrives")
     last = vehicle.n_units - 1
-    rear_x = vehicle.units[last].rearmost_axle.x_m
-
-    def rear_axle_radius(ss):
-        pts = run.unit_points(np.atleast_1d(ss), last, [rear_x], [0.0])
-        return np.where(_sector_mask(pts, centre, angle), radius(pts), np.inf)[:, 0]
-    vals = rear_axle_radius(s)
-    k = int(np.argmin(vals))
-    r_min, _ = _refine(lambda x: float(rear_axle_radius(x)[0]), s, vals, k, -1.0)
-    offtracking = R_axle - r_min
-    # tail swing: rear outer (right) corner beyond its approach line Y = its initial Y
+    rear = vehicle.units[last].rearmost_axle
+    r_rear = _extreme(_Probe("rear axle centre", point(last, rear.x_m, 0.0), heading(last)), radius, -1.0, s, centre,
+                      0.0, angle)
+    if r_rear is None:                           # the turn is beyond the vehicle (or too short): no measure
+        why = never.format(what=f"the last unit's rearmost axle {rear.name}", angle=angle_deg)
+        undefined = {key: why for key in ("lssp_m", "low_speed_offtracking_m", "frontal_swing_m",
+                                          "max_tail_swing_m")}
+        return LowSpeedTurn(vehicle, float(radius_m), float(angle_deg), None, None, {}, None, float(length), run,
+                            {"steer_axle_radius_m": math.nan}, undefined)
+    found_out = [(r, p.name) for p in outer if (r := _extreme(p, radius, +1.0, s, centre, 0.0, angle))]
+    found_in = [(r, p.name) for p in inner if (r := _extreme(p, radius, -1.0, s, centre, 0.0, angle))]
+    best_out = max(((r[0], r[1], name) for r, name in found_out), key=lambda r: r[0], default=None)
+    best_in = min(((r[0], r[1], name) for r, name in found_in), key=lambda r: r[0], default=None)
+    lssp = None if best_out is None or best_in is None else best_out[0] - best_in[0]
+    if lssp is None:
+        undefined["lssp_m"] = never.format(what="the vehicle's inner or outer edge", angle=angle_deg)
+    # low-speed offtracking: the steered axle centre's path against the last unit's rearmost axle centre
+    r_steer = _extreme(_Probe("steered axle centre", point(0, steer.x_m, 0.0), heading(0)), radius, +1.0, s, centre,
+                       0.0, angle)
+    offtracking = None if r_steer is None else r_steer[0] - r_rear[0]
+    if offtracking is None:
+        undefined["low_speed_offtracking_m"] = never.format(what=f"the centre of axle {steer.name}", angle=angle_deg)
+    # tail swing: the rear outer (right) corner beyond its approach line Y = its initial Y, while the
+    # unit has turned less than a quarter turn
     tail = {}
+    quarter = min(angle, math.pi / 2)
     for k_u, u in enumerate(vehicle.units):
-        y0 = run.unit_points([0.0], k_u, [u.body_rear_m], [-u.body_width_m / 2])[0, 0, 1]
-
-        def outward(ss, k_u=k_u, u=u, y0=y0):
-            return y0 - run.unit_points(np.atleast_1d(ss), k_u, [u.body_rear_m], [-u.body_width_m / 2])[:, 0, 1]
-        vals = outward(s)
-        k = int(np.argmax(vals))
-        val, _ = _refine(lambda x: float(outward(x)[0]), s, vals, k, +1.0)
-        tail[u.name] = max(0.0, val)
+        corner = point(k_u, u.body_rear_m, -u.body_width_m / 2)
+        y0 = float(corner(np.array([0.0]))[0, 1])
+        turned = np.flatnonzero(heading(k_u)(s) >= quarter)
+        s_end = s[turned[0]] if turned.size else s[-1]
+        grid = s[s <= s_end] if s_end > 0 else s[:1]
+        probe = _Probe(f"{u.name} rear outer corner", corner, heading(k_u))
+        res = _extreme(probe, lambda pts, y0=y0: y0 - pts[..., 1], +1.0, grid, centre, -math.inf,
+                       math.inf)                     # no sector: the whole entry, up to the quarter turn
+        tail[u.name] = max(0.0, res[0]) if res else 0.0
     # frontal swing: unit 1's front outer (right) corner outside the outside wheel's circle
-    def front_out(ss):
-        pts = run.unit_points(np.atleast_1d(ss), 0, [u1.body_front_m], [-u1.body_width_m / 2])
-        return np.where(_sector_mask(pts, centre, angle), radius(pts), -np.inf)[:, 0] - radius_m
-    vals = front_out(s)
-    k = int(np.argmax(vals))
-    frontal = max(0.0, _refine(lambda x: float(front_out(x)[0]), s, vals, k, +1.0)[0]) if np.isfinite(vals[k]) \
-        else 0.0
-    return LowSpeedTurn(vehicle, float(radius_m), float(angle_deg), float(best_out - best_in), float(offtracking),
-                        tail, float(frontal), float(length), run,
-                        {"outermost": where_out, "innermost": where_in, "outer_radius_m": float(best_out),
-                         "inner_radius_m": float(best_in)})
+    front = _extreme(_Probe("front outer corner", point(0, u1.body_front_m, -u1.body_width_m / 2), heading(0)),
+                     lambda pts: radius(pts) - radius_m, +1.0, s, centre, 0.0, angle)
+    frontal = max(0.0, front[0]) if front is not None else None
+    if frontal is None:
+        undefined["frontal_swing_m"] = never.format(what="unit 1's front outer corner", angle=angle_deg)
+    where = {"outermost": best_out[2] if best_out else "", "innermost": best_in[2] if best_in else "",
+             "outer_radius_m": best_out[0] if best_out else math.nan,
+             "inner_radius_m": best_in[0] if best_in else math.nan,
+             "steer_axle_radius_m": r_steer[0] if r_steer else math.nan}
+    return LowSpeedTurn(vehicle, float(radius_m), float(angle_deg), None if lssp is None else float(lssp),
+                        None if offtracking is None else float(offtracking), tail,
+                        None if frontal is None else float(frontal), float(length), run, where, undefined)

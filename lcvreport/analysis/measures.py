@@ -377,20 +377,21 @@ def conicity_sensitivity(vehicle: Vehicle, speed_mps: float, tire_scale: float =
 
 @dataclass(frozen=True)
 class MeasureSet:
-    """The measures of SPEC section 8 for one vehicle at one speed.
-
-    ``to_dict()`` gives the JSON of ``lcv measures`` (keys fixed by the SPEC).
+    """Every measure of :data:`lcvreport.analysis.registry.MEASURES` for one vehicle at one
+    speed, by keyword (the registry's keys; ``trim`` holds ``trim.delta_rad`` and
+    ``trim.offtracking_m``).  ``to_dict()`` gives the JSON of ``lcv measures``, in the
+    registry's order, with ``reasons`` for every null; ``rows()`` the text and report table.
     """
 
     vehicle: Vehicle
     speed_mps: float
-    tire_scale: float
-    least_damping_ratio: float | None
-    least_damped_frequency_hz: float | None
-    critical_speed_kph: float | None
-    ra_frequency: float | None
-    ra_single_sine: float | None
-    ay_gain_per_unit: list[float] | None
+    tire_scale: float = 1.0
+    least_damping_ratio: float | None = None
+    least_damped_frequency_hz: float | None = None
+    critical_speed_kph: float | None = None
+    ra_frequency: float | None = None
+    ra_single_sine: float | None = None
+    ay_gain_per_unit: list[float] | None = None
     trim: Trim | None = None
     load_units: tuple[str, ...] = ()
     f_hz: float = RA_FREQUENCY_HZ
@@ -399,6 +400,7 @@ class MeasureSet:
     ra_peak: float | None = None
     ra_peak_frequency_hz: float | None = None
     yaw_damping_coefficient: float | None = None
+    yaw_damping_lower_bound: float | None = None
     hsto_m: float | None = None
     ra_lane_change: float | None = None
     hsso_m: float | None = None
@@ -409,105 +411,108 @@ class MeasureSet:
     max_tail_swing_m: float | None = None
     frontal_swing_m: float | None = None
 
+    def value(self, key: str):
+        """The value of the registry key ``key`` (None where undefined)."""
+        if key.startswith("trim."):
+            return None if self.trim is None else getattr(self.trim, key.split(".", 1)[1])
+        value = getattr(self, key)
+        return list(value) if isinstance(value, (list, tuple)) else value
+
+    def reason(self, key: str) -> str | None:
+        """Why the measure ``key`` is null (None when it has a value)."""
+        if self.value(key) is not None:
+            return None
+        if key.startswith("trim."):
+            return self.undefined.get("trim", "no residual source was given (--load, --residual, "
+                                              "--misalignment, --crossfall-percent, --tires)")
+        if key == "critical_speed_kph":
+            return self.undefined.get(key, f"stable at every speed up to {CRITICAL_SPEED_MAX_KPH:g} km/h")
+        if key == "least_damping_ratio" or key == "least_damped_frequency_hz":
+            return self.undefined.get(key, "no mode oscillates")
+        if key == "yaw_damping_lower_bound":
+            return "the yaw damping coefficient has a value (the bound is only given when every joint is " \
+                   "heavily damped)" if self.yaw_damping_coefficient is not None else \
+                self.undefined.get("yaw_damping_coefficient", "")
+        return self.undefined.get(key, "undefined")
+
     def to_dict(self) -> dict:
-        """The SPEC section 8 JSON document."""
-        doc = {"speed_mps": self.speed_mps, "least_damping_ratio": self.least_damping_ratio,
-               "least_damped_frequency_hz": self.least_damped_frequency_hz,
-               "critical_speed_kph": self.critical_speed_kph, "ra_frequency": self.ra_frequency,
-               "ra_single_sine": self.ra_single_sine,
-               "ay_gain_per_unit": None if self.ay_gain_per_unit is None else list(self.ay_gain_per_unit)}
-        for key in FIELD_KEYS + LOW_SPEED_KEYS:
-            doc[key] = getattr(self, key)
-        if self.trim is not None:
-            doc["trim"] = {"delta_rad": self.trim.delta_rad, "offtracking_m": self.trim.offtracking_m}
-        elif "trim" in self.undefined:
-            doc["trim"] = None
+        """The JSON of ``lcv measures`` (SPEC sections 8, 12, 16): the registry's keys in its order
+        (a dotted key nested: ``trim`` holds ``delta_rad`` and ``offtracking_m``, present with a
+        residual source), and ``reasons``: {key: why it is null} for every null."""
+        from .registry import MEASURES
+        doc, reasons = {}, {}
+        for key in MEASURES:
+            if key.startswith("trim."):
+                if self.trim is None and "trim" not in self.undefined:
+                    continue                         # no residual source: no trim (SPEC 8)
+                doc["trim"] = None if self.trim is None else {"delta_rad": self.trim.delta_rad,
+                                                              "offtracking_m": self.trim.offtracking_m}
+                if self.trim is None:
+                    reasons["trim"] = self.reason(key)
+                continue
+            doc[key] = self.value(key)
+            if doc[key] is None:
+                reasons[key] = self.reason(key)
+        doc["reasons"] = reasons
         return doc
 
     def rows(self) -> list[dict]:
-        """The measures as table rows: name, value, unit, definition, and the key of the
-        same number in :meth:`to_dict` (``ay_gain_per_unit[0]`` for list items)."""
-        def num(v):
-            return "none" if v is None else v
+        """The measures as table rows: name, value, unit, definition (or why it is null), and
+        the key of the same number in :meth:`to_dict` (``ay_gain_per_unit[0]`` for list items)."""
+        from .registry import MEASURES
         f = f"{self.f_hz:g} Hz"
-        rows = [{"measure": "speed", "value": self.speed_mps, "unit": "m/s",
-                 "note": f"{mps_to_kph(self.speed_mps):.1f} km/h", "json_key": "speed_mps"},
-                {"measure": "least damping ratio", "value": num(self.least_damping_ratio), "unit": "-",
-                 "note": "min −Re λ/|λ| over oscillatory modes", "json_key": "least_damping_ratio"},
-                {"measure": "least damped frequency", "value": num(self.least_damped_frequency_hz), "unit": "Hz",
-                 "note": "Im λ/2π of that mode", "json_key": "least_damped_frequency_hz"},
-                {"measure": "critical speed", "value": num(self.critical_speed_kph), "unit": "km/h",
-                 "note": "lowest unstable speed up to 200 km/h (none: stable)", "json_key": "critical_speed_kph"},
-                {"measure": f"rearward amplification, {f}", "value": num(self.ra_frequency), "unit": "-",
-                 "note": self.undefined.get("ra_frequency", "|G_N| / |G_1|, frequency domain"),
-                 "json_key": "ra_frequency"},
-                {"measure": "rearward amplification, single sine", "value": num(self.ra_single_sine), "unit": "-",
-                 "note": self.undefined.get("ra_single_sine", f"max|a_N| / max|a_1|, {f} single sine"),
-                 "json_key": "ra_single_sine"}]
-        if self.ay_gain_per_unit is None:
-            rows.append({"measure": "lateral acceleration gains", "value": "none", "unit": "m/s²/rad",
-                         "note": self.undefined.get("ay_gain_per_unit", ""), "json_key": "ay_gain_per_unit"})
-        for k, (name, g) in enumerate(zip(self.vehicle.unit_names, self.ay_gain_per_unit or ())):
-            rows.append({"measure": f"lateral acceleration gain, {name}", "value": g, "unit": "m/s²/rad",
-                         "note": f"|G_{k + 1}(j2π·{f})|", "json_key": f"ay_gain_per_unit[{k}]"})
-        for key, (label, unit, note) in {**FIELD_ROWS, **LOW_SPEED_ROWS}.items():
-            value = getattr(self, key)
-            rows.append({"measure": label, "value": num(value), "unit": unit,
-                         "note": self.undefined.get(key, note), "json_key": key})
-        if "trim" in self.undefined:
-            rows.append({"measure": "trim", "value": "none", "unit": "", "note": self.undefined["trim"],
-                         "json_key": "trim"})
-        if self.trim is not None:
-            what = "; ".join(x for x in (f"1 % rule on {', '.join(self.load_units)}" if self.load_units else "",
-                                          self.sources.describe() if self.sources else "") if x)
-            rows.append({"measure": "trim steer angle", "value": self.trim.delta_rad, "unit": "rad",
-                         "note": what, "json_key": "trim.delta_rad"})
-            rows.append({"measure": "trimmed offtracking", "value": self.trim.offtracking_m, "unit": "m",
-                         "note": "rearmost axle path − steered axle path, +y", "json_key": "trim.offtracking_m"})
+        rows = []
+        for key, m in MEASURES.items():
+            value = self.value(key)
+            if key == "speed_mps":
+                rows.append({"measure": m.label, "value": value, "unit": m.unit,
+                             "note": f"{mps_to_kph(self.speed_mps):.1f} km/h", "json_key": key})
+            elif m.shape == "per_unit":
+                if value is None:
+                    rows.append({"measure": m.label + "s", "value": "none", "unit": m.unit,
+                                 "note": self.reason(key), "json_key": key})
+                for k, (name, g) in enumerate(zip(self.vehicle.unit_names, value or ())):
+                    rows.append({"measure": f"{m.label}, {name}", "value": g, "unit": m.unit,
+                                 "note": f"|G_{k + 1}(j2π·{f})|", "json_key": f"{key}[{k}]"})
+            elif key.startswith("trim."):
+                if self.trim is not None:
+                    what = "; ".join(x for x in (f"1 % rule on {', '.join(self.load_units)}" if self.load_units
+                                                 else "", self.sources.describe() if self.sources else "") if x)
+                    rows.append({"measure": m.label, "value": value, "unit": m.unit,
+                                 "note": what if key == "trim.delta_rad" else m.definition, "json_key": key})
+                elif "trim" in self.undefined and key == "trim.delta_rad":
+                    rows.append({"measure": "trim", "value": "none", "unit": "", "note": self.undefined["trim"],
+                                 "json_key": "trim"})
+            else:
+                note = m.definition if value is not None else self.reason(key)
+                if key in ("ra_frequency", "ra_single_sine"):
+                    note = note.replace("0.4 Hz", f)
+                rows.append({"measure": m.label.replace("0.4 Hz", f), "value": "none" if value is None else value,
+                             "unit": m.unit, "note": note, "json_key": key})
         return rows
 
 
-#: the SPEC section 12 keys of :meth:`MeasureSet.to_dict`, in order
-FIELD_KEYS = ("ra_peak", "ra_peak_frequency_hz", "yaw_damping_coefficient", "hsto_m", "ra_lane_change", "hsso_m",
-              "steady_turn_delta_rad")
-#: their table rows: label, unit, definition
-FIELD_ROWS = {
-    "ra_peak": ("rearward amplification, peak", "-", "max RA(f) over 0.1-2 Hz"),
-    "ra_peak_frequency_hz": ("frequency of the RA peak", "Hz", "where RA(f) is largest"),
-    "yaw_damping_coefficient": ("yaw damping coefficient", "-", "ratio method, pulse 0.01 rad 0.5 s, 40 s"),
-    "hsto_m": ("high-speed transient offtracking", "m", "lane change 0.15 g 0.4 Hz, rear axle overshoot"),
-    "ra_lane_change": ("rearward amplification, lane change", "-", "max|a_N| / max|a_s| in that lane change"),
-    "hsso_m": ("high-speed steady-state offtracking", "m", "393 m turn: rear axle radius - steered axle radius"),
-    "steady_turn_delta_rad": ("steer angle of the 393 m turn", "rad", "the steady turn of HSSO"),
-}
-
-
-#: the SPEC section 16 keys (the low-speed 90 degree turn, outside steer wheel on 12.5 m; any speed)
-LOW_SPEED_KEYS = ("lssp_m", "low_speed_offtracking_m", "max_tail_swing_m", "frontal_swing_m")
-LOW_SPEED_ROWS = {
-    "lssp_m": ("low-speed swept path (swept width)", "m", "90° turn, outside steer wheel on R 12.5 m"),
-    "low_speed_offtracking_m": ("low-speed offtracking", "m", "steered axle path radius − last rear axle radius"),
-    "max_tail_swing_m": ("tail swing, largest", "m", "rear outer corner beyond its approach line"),
-    "frontal_swing_m": ("frontal swing", "m", "front outer corner outside the outside steer wheel's path"),
-}
-
-
 @functools.lru_cache(maxsize=64)
-def low_speed_measures(vehicle: Vehicle) -> tuple[dict, str | None]:
-    """The SPEC section 16 measures of ``vehicle`` (independent of speed and tire scale:
-    cached per vehicle), or ``({}, why)`` when the file lacks the geometry."""
+def low_speed_measures(vehicle: Vehicle) -> tuple[dict, dict]:
+    """The SPEC section 16 measures of ``vehicle`` (independent of speed and tire scale: cached
+    per vehicle) and, for each that is null, why: (values, reasons)."""
     from .low_speed_turn import TurnError, low_speed_turn
     try:
         t = low_speed_turn(vehicle)
     except TurnError as exc:
-        return {}, f"undefined: {exc}"
-    return {"lssp_m": t.lssp_m, "low_speed_offtracking_m": t.low_speed_offtracking_m,
-            "max_tail_swing_m": t.max_tail_swing_m, "frontal_swing_m": t.frontal_swing_m}, None
+        return {}, {k: f"undefined: {exc}" for k in LOW_SPEED_KEYS}
+    values = {"lssp_m": t.lssp_m, "low_speed_offtracking_m": t.low_speed_offtracking_m,
+              "max_tail_swing_m": t.max_tail_swing_m, "frontal_swing_m": t.frontal_swing_m}
+    return values, {k: f"undefined: {why}" for k, why in t.undefined.items()}
+
+
+#: the low-speed measures' keys (a second model: computed per vehicle, cached)
+LOW_SPEED_KEYS = ("lssp_m", "low_speed_offtracking_m", "max_tail_swing_m", "frontal_swing_m")
 
 
 def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, load_units=None,
                 f_hz: float = RA_FREQUENCY_HZ, sources=None) -> MeasureSet:
-    """Every SPEC section 8 and 12 measure of ``vehicle`` at ``speed_mps`` [m/s].
+    """Every measure of the registry (SPEC sections 8, 12, 16) of ``vehicle`` at ``speed_mps`` [m/s].
 
     Parameters
     ----------
@@ -535,15 +540,18 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     units = tuple(load_units) if load_units else ()
     has_sources = bool(units) or bool(sources)
     low, low_why = low_speed_measures(vehicle)
+    undefined = dict(low_why)
+    common = dict(vehicle=vehicle, speed_mps=float(speed_mps), tire_scale=float(tire_scale),
+                  least_damping_ratio=zeta, least_damped_frequency_hz=f_zeta,
+                  critical_speed_kph=critical_speed(vehicle, tire_scale), load_units=units, f_hz=float(f_hz),
+                  sources=sources, **low)
     if not vehicle.steered_axles:
+        from .registry import MEASURES
         why = "undefined: the vehicle has no steered axle, so no steer input to respond to or trim with"
-        undefined = {k: why for k in ("ra_frequency", "ra_single_sine", "ay_gain_per_unit") + FIELD_KEYS}
-        undefined.update({k: low_why for k in LOW_SPEED_KEYS if low_why})
+        undefined.update({k: why for k, m in MEASURES.items() if m.needs == "steer"})
         if has_sources:
             undefined["trim"] = why
-        return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
-                          critical_speed(vehicle, tire_scale), None, None, None, None, units, float(f_hz), undefined,
-                          sources=sources, **low)
+        return MeasureSet(undefined=undefined, **common)
     gains = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
     # only the numbers are kept: each manoeuvre's response (up to a megabyte of samples) is freed
     # before the next one is computed (a smaller heap, which malloc does not hand back and fault in)
@@ -557,10 +565,9 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
             F = F + sources.vector(vehicle, tire_scale)
         tr = trim(vehicle, speed_mps, F, tire_scale)
         check_trim(tr)
-    undefined = {k: low_why for k in LOW_SPEED_KEYS if low_why}
     peak = fm.ra_peak(vehicle, speed_mps, tire_scale)
     ydc = fm._yaw_damping(vehicle, speed_mps, tire_scale, zeta)
-    ydc_value = ydc.value
+    ydc_value, ydc_bound = ydc.value, ydc.lower_bound
     if ydc_value is None:
         undefined["yaw_damping_coefficient"] = f"undefined: {ydc.why}"
     del ydc
@@ -572,10 +579,11 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
         hsto = ra_lc = None
         undefined["hsto_m"] = undefined["ra_lane_change"] = f"undefined: {exc}"
     turn = fm.steady_turn(vehicle, speed_mps, tire_scale)
-    return MeasureSet(vehicle, float(speed_mps), float(tire_scale), zeta, f_zeta,
-                      critical_speed(vehicle, tire_scale), float(gains[-1] / gains[0]), ra_ss,
-                      [float(g) for g in gains], tr, units, float(f_hz), undefined, peak.value, peak.frequency_hz,
-                      ydc_value, hsto, ra_lc, turn.hsso_m, turn.delta_rad, sources, **low)
+    return MeasureSet(ra_frequency=float(gains[-1] / gains[0]), ra_single_sine=ra_ss,
+                      ay_gain_per_unit=[float(g) for g in gains], trim=tr, undefined=undefined,
+                      ra_peak=peak.value, ra_peak_frequency_hz=peak.frequency_hz,
+                      yaw_damping_coefficient=ydc_value, yaw_damping_lower_bound=ydc_bound, hsto_m=hsto,
+                      ra_lane_change=ra_lc, hsso_m=turn.hsso_m, steady_turn_delta_rad=turn.delta_rad, **common)
 
 
 def check_trim(tr: Trim) -> None:

@@ -245,6 +245,9 @@ def config_data_header(itf: Interface) -> str:
         + ", ".join(out_kind.get(v.source[0], "LCV_OUT_LINEAR") for v in itf.outputs) + "};",
         "static const unsigned LCV_ME_STATE_VR[LCV_N_ME_STATES] = {"
         + ", ".join(str(v.value_reference) for v in itf.continuous_states) + "};",
+        "/* the states' nominals: their physical scale (Interface.state_nominals) */",
+        "static const double LCV_ME_NOMINAL[LCV_N_ME_STATES] = {"
+        + ", ".join(_c_double(x) for x in itf.state_nominals()) + "};",
         "", "#endif", ""])
 
 
@@ -559,10 +562,23 @@ def build_preset_fmus(out_dir: Path) -> list[Path]:
             build_python_fmu3(itf, out_dir, "LCV3"), build_native_fmu3(itf, out_dir, "LCVNative3")]
 
 
+def fmi3_python_name(name: str) -> str:
+    """The model identifier of a vehicle's FMI 3 Python FMU: ``<name>3``, or ``<name>_fmi3`` when the
+    name ends in a digit (``bdouble26_fmi3``, not ``bdouble263``, which reads as another vehicle).
+
+    Examples
+    --------
+    >>> fmi3_python_name("my_semi"), fmi3_python_name("nu4_bdouble26")
+    ('my_semi3', 'nu4_bdouble26_fmi3')
+    """
+    return f"{name}_fmi3" if name[-1:].isdigit() else f"{name}3"
+
+
 def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both",
                        u_start_mps: float = U_START, fmi: int = 2) -> list[Path]:
     """``<name>.fmu`` (pythonfmu) and/or ``<name>Native.fmu`` (C99) of a vehicle (SPEC section 9);
-    with ``fmi=3``, ``<name>3.fmu`` (pythonfmu3) and/or ``<name>Native3.fmu`` (SPEC section 15).
+    with ``fmi=3``, ``<name>3.fmu`` (pythonfmu3; ``<name>_fmi3.fmu`` when the name ends in a digit)
+    and/or ``<name>Native3.fmu`` (SPEC section 15).
 
     Parameters
     ----------
@@ -581,7 +597,7 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
     out = []
     if fmi == 3:
         if kind in ("python", "both"):
-            out.append(build_python_fmu3(itf, Path(out_dir), f"{vehicle.name}3"))
+            out.append(build_python_fmu3(itf, Path(out_dir), fmi3_python_name(vehicle.name)))
         if kind in ("native", "both"):
             out.append(build_native_fmu3(itf, Path(out_dir), f"{vehicle.name}Native3"))
         return out

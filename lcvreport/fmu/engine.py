@@ -167,6 +167,13 @@ class LCVEngine:
                 self._C[o, n + 1] = 1.0
             elif kind == "Y_rear":
                 self._C[o] = rear_row
+            elif kind == "Y_axle":                            # an axle centre: c . [psi1, Y1, Theta]
+                i = v.axle_units[v.axle_names.index(var.source[1])]
+                ca = point_lateral_map(v, i, v.axles[v.axle_names.index(var.source[1])].x_m)
+                row = ca[2:] @ cum
+                row[n] += ca[0]
+                row[n + 1] += ca[1]
+                self._C[o] = row
             elif kind == "y" and var.source[1] <= nu:
                 self._W[o] = W_all[var.source[1] - 2]
             elif kind == "ay" and var.source[1] <= nu:

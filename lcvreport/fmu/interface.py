@@ -18,7 +18,7 @@ Two interfaces (SPEC sections 5 and 9):
   .. ay6`` after the SPEC section 5 outputs.
 * :func:`vehicle_interface`: the vehicle built in; inputs ``P_<axle>``, ``T_<axle>``,
   ``eps_<axle>``; outputs ``v1, r1..rN, theta1..theta(N-1), ay1..ayN, y2..yN, psi1, Y1,
-  Y_rear, max_real_eig``.
+  Y_rear, max_real_eig, Y_<axle>`` (every axle centre's global lateral position).
 
 Value references are the table's order: parameters, inputs, outputs, each a block
 (address variables by name, as modelDescription.xml gives them).
@@ -32,6 +32,8 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from ..model.presets import PRESETS
 from ..model.vehicle import Vehicle, joint_letter
@@ -82,7 +84,7 @@ class FmuVariable:
     source : tuple
         What the engine reads or writes: ``("parameter", name)``, ``("speed",)``,
         ``("steer",)``, ``("P", axle)``, ``("T", axle)``, ``("state", state_name)``,
-        ``("ay", unit)``, ``("y", unit)``, ``("psi1",)``, ``("Y1",)``, ``("Y_rear",)``,
+        ``("ay", unit)``, ``("y", unit)``, ``("psi1",)``, ``("Y1",)``, ``("Y_rear",)``, ``("Y_axle", axle)``,
         ``("max_real_eig",)``; units 1-based.
     minimum, maximum : float or None
         Valid range (from :data:`lcvreport.ranges.RANGES`), written as min/max.
@@ -162,6 +164,37 @@ class Interface:
         """The Model Exchange states: the outputs v1, r1..rN, the articulation angles, psi1, Y1
         (SPEC section 15), in value-reference order."""
         return tuple(v for v in self.outputs if v.source[0] in ("state", "psi1", "Y1"))
+
+    def state_nominals(self) -> tuple[float, ...]:
+        """The nominal of every Model Exchange state (:attr:`continuous_states` order): its
+        physical scale, the peak |state| of the field's standard manoeuvre -- the single sine
+        0.01 rad at 0.4 Hz from rest, at the start speed of ``u``, over 1/f + 8 s -- over the
+        vehicles of this FMU (a vehicle with no steered axle: a 1 kN residual force on its
+        rearmost axle for 10 s).  A host's integrator scales its absolute tolerance by it
+        (fmusim's CVODE: atol = rtol x nominal), so states of a few milliradians are resolved.
+        Computed at build time (the FMU's runtime does not compute it)."""
+        from ..analysis.exact import response
+        from ..analysis.manoeuvres import sine, step
+        from ..model.builder import system_coefficients
+        u = float(self.by_name["u"].start)
+        peaks = np.zeros(len(self.continuous_states))
+        for v in self.vehicles:
+            names = []
+            for var in self.continuous_states:
+                i = self.state_index(var, v)
+                names.append(None if i < 0 else (list(v.state_names) + ["psi1", "Y1"])[i])
+            if v.steered_axles:
+                r = response(v, u, sine(0.01, 0.4), 10.5, 0.01)
+            else:
+                co = system_coefficients(v)
+                r = response(v, u, step(0.0), 10.0, 0.01, F=1e3 * co.B_P[:, -1])
+            got = r.peaks_abs([n for n in names if n is not None])
+            k = 0
+            for j, n in enumerate(names):
+                if n is not None:
+                    peaks[j] = max(peaks[j], float(got[k]))
+                    k += 1
+        return tuple(float(max(p, 1e-6)) for p in peaks)
 
     def state_index(self, variable: FmuVariable, vehicle: Vehicle) -> int:
         """Index of a continuous state in the model's z = [x, psi1, Y1] of ``vehicle``; -1 for a
@@ -336,6 +369,11 @@ def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START) -> Interfa
         t.add(f"y{k}", "output", "continuous", "length", None, f"Lateral offset of the rear end of "
               f"{vehicle.units[k - 1].name} (unit {k}) from the axis of {vehicle.units[0].name}", ("y", k))
     _tail_outputs(t, vehicle.units[-1].name)
+    for i, u in enumerate(vehicle.units):            # after the others: their value references stay as they were
+        for a in u.axles:
+            t.add(f"Y_{a.name}", "output", "continuous", "length", None, f"Global lateral position of the centre of "
+                  f"axle {a.name} of {u.name} (unit {i + 1}) from the start, +y (first order; HSTO is the rearmost "
+                  "axle's overshoot in a lane change)", ("Y_axle", a.name))
     desc = (f"Linear yaw-plane model of {vehicle.name} ({n} units: {', '.join(vehicle.unit_names)}) with residual "
             "tire forces (conicity, ply steer). Exact zero-order-hold stepping for any communication step size."
             + (f" {vehicle.description}" if vehicle.description else ""))

@@ -236,6 +236,7 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
                                                     description=f"Values of {v.name}"), "Enumeration"), v)
     categories_and_experiment(root)
     mv = SubElement(root, "ModelVariables")
+    nominal = dict(zip((v.name for v in itf.continuous_states), itf.state_nominals())) if native else {}
     for v in itf.variables:
         sv = SubElement(mv, "ScalarVariable", variable_attributes(v))
         if v.type == "Enumeration":
@@ -256,6 +257,8 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
                 real["max"] = _num(v.maximum)
         if v.start is not None:
             real["start"] = _num(v.start)
+        if v.name in nominal:                     # a Model Exchange state: its physical scale
+            real["nominal"] = _num(nominal[v.name])
         SubElement(sv, "Real", real)
     index = {v.name: v.value_reference + 1 for v in itf.variables}
     derivatives = []

@@ -70,6 +70,7 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
     t_vr = time_value_reference(itf)
     SubElement(mv, "Float64", {"name": "time", "valueReference": str(t_vr), "causality": "independent",
                                "variability": "continuous", "unit": "s", "description": "Simulation time"})
+    nominal = dict(zip((v.name for v in itf.continuous_states), itf.state_nominals())) if native else {}
     for v in itf.variables:
         attrs = variable_attributes(v)
         if v.type == "Enumeration":
@@ -89,6 +90,8 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
                 attrs["max"] = _num(v.maximum)
         if v.start is not None:
             attrs["start"] = _num(v.start)
+        if v.name in nominal:                     # a Model Exchange state: its physical scale
+            attrs["nominal"] = _num(nominal[v.name])
         SubElement(mv, "Float64", attrs)
     der_vr = {}
     for k, sv in enumerate(states):

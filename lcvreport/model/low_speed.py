@@ -2,9 +2,11 @@ r"""Low-speed kinematics of a combination: plane motion at walking pace, no iner
 
 A second model beside the linear yaw-plane one: angles of any size, no speed, no mass.
 
-* **Pull points.** Unit 1 is pulled at the centre of its frontmost steered axle, which
-  follows a prescribed path; unit i >= 2 at its front coupling, which moves with unit
-  i-1's rear coupling.
+* **Pull points.** Unit 1 is pulled at a point of its frontmost steered axle -- its centre,
+  or (``pull_offset_m``) a point across the unit from it, such as the turn's outside wheel --
+  which follows a prescribed path; unit i >= 2 at its front coupling, which moves with unit
+  i-1's rear coupling.  A lateral offset of the pull point does not change the heading law:
+  the velocity across the unit's axis is the same at every point of one line across it.
 * **Heading.** With no inertia the lateral forces of a unit's axles have no moment about
   its pull point.  With linear tires (C_j = tires x C_F of axle j, aligning and dual-tire
   terms neglected; the steered axles of unit 1 carry no lateral force) and d_j the signed
@@ -55,10 +57,12 @@ class UnitGeometry:
     d_m: np.ndarray               # axle x from the pull point, the axles that carry lateral force
     C_N_per_rad: np.ndarray       # tires x C_F of those axles
     gain_per_m: float             # sum C d / sum C d^2 [1/m]
+    pull_y_m: float = 0.0         # the pull point's y (to the left) on the unit's frame
 
 
-def unit_geometry(vehicle: Vehicle) -> list[UnitGeometry]:
-    """Pull points and the heading law's gain of every unit.
+def unit_geometry(vehicle: Vehicle, pull_offset_m: float = 0.0) -> list[UnitGeometry]:
+    """Pull points and the heading law's gain of every unit; unit 1's pull point is
+    ``pull_offset_m`` [m] to the left (negative: right) of its frontmost steered axle's centre.
 
     Raises
     ------
@@ -86,7 +90,8 @@ def unit_geometry(vehicle: Vehicle) -> list[UnitGeometry]:
         if not den > 0:
             raise KinematicsError(f'unit {k + 1} "{u.name}": every axle is at its pull point; its heading is '
                                   "not fixed")
-        out.append(UnitGeometry(pull, u.rear_coupling_m, d, C, float(np.sum(C * d)) / den))
+        out.append(UnitGeometry(pull, u.rear_coupling_m, d, C, float(np.sum(C * d)) / den,
+                                float(pull_offset_m) if k == 0 else 0.0))
     return out
 
 
@@ -183,9 +188,10 @@ class KinematicRun:
         P[:, 0] = self.path.point(s_arr)
         for i in range(1, len(self.geometry)):
             g = self.geometry[i - 1]
-            L = g.rear_coupling_x_m - g.pull_x_m
-            P[:, i, 0] = P[:, i - 1, 0] + L * np.cos(psi[:, i - 1])
-            P[:, i, 1] = P[:, i - 1, 1] + L * np.sin(psi[:, i - 1])
+            lx, ly = g.rear_coupling_x_m - g.pull_x_m, -g.pull_y_m
+            c, sn = np.cos(psi[:, i - 1]), np.sin(psi[:, i - 1])
+            P[:, i, 0] = P[:, i - 1, 0] + c * lx - sn * ly
+            P[:, i, 1] = P[:, i - 1, 1] + sn * lx + c * ly
         return P
 
     def unit_points(self, s, k: int, x_m, y_m) -> np.ndarray:
@@ -195,14 +201,15 @@ class KinematicRun:
         psi = self.headings(s_arr).reshape(s_arr.size, -1)[:, k]
         P = self.pull_points(s_arr)[:, k]
         x = np.atleast_1d(np.asarray(x_m, dtype=float)) - self.geometry[k].pull_x_m
-        y = np.atleast_1d(np.asarray(y_m, dtype=float))
+        y = np.atleast_1d(np.asarray(y_m, dtype=float)) - self.geometry[k].pull_y_m
         c, sn = np.cos(psi)[:, None], np.sin(psi)[:, None]
         return np.stack([P[:, None, 0] + c * x - sn * y, P[:, None, 1] + sn * x + c * y], axis=-1)
 
 
 def _rhs(geometry, path):
     n = len(geometry)
-    lever = [(g.rear_coupling_x_m - g.pull_x_m) if g.rear_coupling_x_m is not None else 0.0 for g in geometry]
+    lever = [((g.rear_coupling_x_m - g.pull_x_m) if g.rear_coupling_x_m is not None else 0.0, -g.pull_y_m)
+             for g in geometry]
 
     def f(s, psi):
         v = path.tangent(s)
@@ -213,14 +220,18 @@ def _rhs(geometry, path):
             v_perp = -sn * vx + c * vy
             rate = -v_perp * geometry[i].gain_per_m
             out[i] = rate
-            # the next unit's pull point: this one's plus the lever turning with this unit
-            vx, vy = vx - lever[i] * rate * sn, vy + lever[i] * rate * c
+            # the next unit's pull point: this one's plus the lever (lx, ly) turning with this unit
+            lx, ly = lever[i]
+            vx, vy = vx - rate * (sn * lx + c * ly), vy + rate * (c * lx - sn * ly)
         return out
     return f
 
 
-def integrate(vehicle: Vehicle, path, psi0, rtol: float = RTOL, atol: float = ATOL) -> KinematicRun:
-    """Headings of every unit along ``path`` from the headings ``psi0`` [rad] at s = 0.
+def integrate(vehicle: Vehicle, path, psi0, rtol: float = RTOL, atol: float = ATOL,
+              pull_offset_m: float = 0.0) -> KinematicRun:
+    """Headings of every unit along ``path`` from the headings ``psi0`` [rad] at s = 0; unit 1's
+    pull point (the point that follows ``path``) is ``pull_offset_m`` [m] to the left of its
+    frontmost steered axle's centre (the outside wheel of a left turn: minus half its track).
 
     Integrated in arc length with :func:`scipy.integrate.solve_ivp` (DOP853), segment by
     segment of the path (its curvature jumps between them).
@@ -240,7 +251,7 @@ def integrate(vehicle: Vehicle, path, psi0, rtol: float = RTOL, atol: float = AT
     KinematicRun
     """
     from scipy.integrate import solve_ivp
-    geometry = tuple(unit_geometry(vehicle))
+    geometry = tuple(unit_geometry(vehicle, pull_offset_m))
     f = _rhs(geometry, path)
     y = np.asarray(psi0, dtype=float).copy()
     pieces = []

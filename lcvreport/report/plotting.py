@@ -693,36 +693,12 @@ def fig_swept_path(turn, title: str, outlines_every_m: float = 2.0) -> Figure:
         ax.add_patch(_Poly(run.unit_points([0.0], k, cx, cy)[0], closed=True, facecolor=PALETTE[k % len(PALETTE)],
                            edgecolor="black", lw=0.5, alpha=0.35, zorder=2,
                            label="the combination before the turn" if k == 0 else None))
-    # envelope within the sector: extremes of corners, wheels and sides in angle bins
-    s_fine = np.linspace(0.0, s_draw_end, 1500)
-    pts = []
-    for k, u in enumerate(v.units):
-        cx, cy = corners(v, k)
-        xs = np.concatenate([cx, np.linspace(u.body_front_m, u.body_rear_m, 12), np.linspace(u.body_front_m,
-                             u.body_rear_m, 12)])
-        ys = np.concatenate([cy, np.full(12, u.body_width_m / 2), np.full(12, -u.body_width_m / 2)])
-        for a in u.axles:
-            xs = np.append(xs, [a.x_m, a.x_m])
-            ys = np.append(ys, [a.track_width_m / 2, -a.track_width_m / 2])
-        pts.append(run.unit_points(s_fine, k, xs, ys).reshape(-1, 2))
-    pts = np.concatenate(pts)
-    rel = pts - C
-    phi = np.arctan2(rel[:, 0], -rel[:, 1])
-    r = np.hypot(rel[:, 0], rel[:, 1])
-    angle = math.radians(min(turn.angle_deg, 360.0))
-    bins = np.linspace(0.0, angle, 91)
-    idx = np.digitize(phi, bins) - 1
-    ok = (idx >= 0) & (idx < 90)
-    r_max = np.full(90, np.nan)
-    r_min = np.full(90, np.nan)
-    for b in range(90):
-        sel = ok & (idx == b)
-        if sel.any():
-            r_max[b], r_min[b] = r[sel].max(), r[sel].min()
-    mid = 0.5 * (bins[1:] + bins[:-1])
+    # the envelope of the swept region within the turn (computed by the turn, drawn here)
+    mid, r_min, r_max = turn.envelope()
     env = lambda rr: np.stack([C[0] + rr * np.sin(mid), C[1] - rr * np.cos(mid)], axis=1)  # noqa: E731
     ax.plot(*env(r_max).T, color="black", lw=1.4, zorder=6, label="envelope of the swept region (in the turn)")
     ax.plot(*env(r_min).T, color="black", lw=1.4, zorder=6)
+    angle = math.radians(min(turn.angle_deg, 360.0))
     # the two wheel paths
     steer = max((a for a in v.units[0].axles if a.steered), key=lambda a: a.x_m)
     s_path = np.linspace(-0.3 * turn.overall_length_m, s_draw_end, 800)
@@ -739,21 +715,24 @@ def fig_swept_path(turn, title: str, outlines_every_m: float = 2.0) -> Figure:
     ax.plot(*C, "+", color="black", ms=8, zorder=6)
     # measures: the swept width along the bisector of the turn, the offtracking in the text
     w = turn.where
-    b = 0.5 * angle
-    u_dir = np.array([math.sin(b), -math.cos(b)])
-    p_in, p_out = C + w["inner_radius_m"] * u_dir, C + w["outer_radius_m"] * u_dir
-    ax.annotate("", p_out, p_in, arrowprops=dict(arrowstyle="<->", lw=0.9, color="black"), zorder=7)
-    ax.text(*(0.5 * (p_in + p_out)), f"  swept width {turn.lssp_m:.2f} m", fontsize=SMALL_PT, zorder=7,
-            rotation=math.degrees(b) - 90 if -90 < math.degrees(b) - 90 < 90 else 0)
+    if turn.lssp_m is not None:
+        b = 0.5 * angle
+        u_dir = np.array([math.sin(b), -math.cos(b)])
+        p_in, p_out = C + w["inner_radius_m"] * u_dir, C + w["outer_radius_m"] * u_dir
+        ax.annotate("", p_out, p_in, arrowprops=dict(arrowstyle="<->", lw=0.9, color="black"), zorder=7)
+        ax.text(*(0.5 * (p_in + p_out)), f"  swept width {turn.lssp_m:.2f} m", fontsize=SMALL_PT, zorder=7,
+                rotation=math.degrees(b) - 90 if -90 < math.degrees(b) - 90 < 90 else 0)
     ax.set_aspect("equal")
     ax.set_xlabel("X [m]")
     ax.set_ylabel("Y [m]")
     ax.grid(True, lw=0.3)
     ax.autoscale_view()
     ax.legend(fontsize=SMALL_PT, loc="upper left")
-    ax.set_title(f"{title}\nswept width {turn.lssp_m:.2f} m, low-speed offtracking "
-                 f"{turn.low_speed_offtracking_m:.2f} m, largest tail swing {turn.max_tail_swing_m:.3f} m, "
-                 f"frontal swing {turn.frontal_swing_m:.2f} m", fontsize=8)
+    def m(value, digits=2):
+        return "not computed" if value is None else f"{value:.{digits}f} m"
+    ax.set_title(f"{title}\nswept width {m(turn.lssp_m)}, low-speed offtracking {m(turn.low_speed_offtracking_m)}, "
+                 f"largest tail swing {m(turn.max_tail_swing_m, 3)}, frontal swing {m(turn.frontal_swing_m)}",
+                 fontsize=8)
     fig.lcv_data = turn.rows()
     return fig
 
@@ -914,18 +893,11 @@ def fig_tire_fit(key: str, ylabel: str, title: str) -> Figure:
     return fig
 
 
-#: units of a study's columns, for axis labels (factors are scales, 1, unless named here)
-STUDY_UNITS = {"speed_kph": "km/h", "speed_mps": "m/s", "least_damping_ratio": "-", "least_damped_frequency_hz": "Hz",
-               "critical_speed_kph": "km/h", "ra_frequency": "-", "ra_single_sine": "-", "ra_peak": "-",
-               "ra_peak_frequency_hz": "Hz", "yaw_damping_coefficient": "-", "hsto_m": "m", "ra_lane_change": "-",
-               "hsso_m": "m", "steady_turn_delta_rad": "rad", "lssp_m": "m", "low_speed_offtracking_m": "m",
-               "max_tail_swing_m": "m", "frontal_swing_m": "m"}
-
-
 def _study_label(name: str) -> str:
     """``trailer3.cornering_stiffness_scale`` -> three short lines and the unit (panels are narrow)."""
     text = name.replace(".", "\n").replace("_stiffness_", "_stiffness\n")
-    return f"{text} [{STUDY_UNITS.get(name, '1')}]"
+    from ..analysis.registry import unit_of
+    return f"{text} [{unit_of(name)}]"
 
 
 def fig_study_scatter(table, factors: list[str], measures: list[str], max_points: int = 2000,

@@ -21,28 +21,8 @@ import numpy as np
 
 from ..analysis.batch import VariantBatch
 from ..analysis.measures import RA_FREQUENCY_HZ, measure_set
-from .spec import BATCHED, TRIM, Study
-
-
-def _batched(batch: VariantBatch, speed_mps: float, tire_scale: float, wanted: set) -> dict:
-    out = {}
-    if wanted & {"least_damping_ratio", "least_damped_frequency_hz"}:
-        out["least_damping_ratio"], out["least_damped_frequency_hz"] = batch.least_damping(speed_mps, tire_scale)
-    if "critical_speed_kph" in wanted:
-        out["critical_speed_kph"] = batch.critical_speed(tire_scale)
-    if "ra_frequency" in wanted:
-        out["ra_frequency"] = batch.rearward_amplification(speed_mps, RA_FREQUENCY_HZ, tire_scale)
-    if "yaw_damping_coefficient" in wanted:
-        out["yaw_damping_coefficient"] = batch.yaw_damping(speed_mps, tire_scale)
-    if wanted & {"hsto_m", "ra_lane_change"}:
-        out["hsto_m"], out["ra_lane_change"] = batch.lane_change(speed_mps, tire_scale)
-    if "ra_single_sine" in wanted:
-        out["ra_single_sine"] = batch.single_sine(speed_mps, RA_FREQUENCY_HZ, tire_scale)
-    if wanted & {"ra_peak", "ra_peak_frequency_hz"}:
-        out["ra_peak"], out["ra_peak_frequency_hz"] = batch.ra_peak(speed_mps, tire_scale)
-    if wanted & {"hsso_m", "steady_turn_delta_rad"}:
-        out["hsso_m"], out["steady_turn_delta_rad"] = batch.steady_turn(speed_mps, tire_scale)
-    return out
+from ..analysis.registry import BATCHED as BATCH_GROUPS
+from .spec import BATCHED, Study
 
 
 def compute_chunk(study: Study, case_ids) -> dict:
@@ -59,37 +39,32 @@ def compute_chunk(study: Study, case_ids) -> dict:
         cols[m] = np.full(ids.size, np.nan)
     v = study.vehicle
     batched = set(study.measures) & set(BATCHED) if v.steered_axles else set()
+    groups = [g for g, keys in BATCH_GROUPS.items() if batched & set(keys)]
     F = None
-    if batched & set(TRIM):
+    if "trim" in groups:
         F = np.full((ids.size, v.n_states), np.nan)           # NaN rows: no source (measure_set's null)
         for k in range(ids.size):
             F[k] = _case_force(study, int(ids[k]))
     if batched:
         keys = np.stack([speeds, scales], axis=1)
-        groups, inverse = np.unique(keys, axis=0, return_inverse=True)
-        for g, (u, ts) in enumerate(groups):
+        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+        for g, (u, ts) in enumerate(uniq):
             rows = np.flatnonzero(inverse.ravel() == g)
             values = {k: arr[rows] for k, arr in params.items()}
             batch = VariantBatch(v, values)
-            for name, arr in _batched(batch, float(u), float(ts), batched).items():
-                if name in batched:
-                    cols[name][rows] = np.broadcast_to(arr, rows.shape)
-            if F is not None:
-                has = np.isfinite(F[rows, 0])
-                if has.any():
-                    sub = batch._subset(np.flatnonzero(has)) if batch.size > 1 else batch
-                    delta, off = sub.trim(float(u), F[rows[has]], float(ts))
-                    cols.get("trim_delta_rad", np.empty(ids.size))[rows[has]] = delta
-                    cols.get("trim_offtracking_m", np.empty(ids.size))[rows[has]] = off
+            for group in groups:
+                arrays = batch.measure_group(group, float(u), float(ts), RA_FREQUENCY_HZ,
+                                             None if F is None else F[rows])
+                for name, arr in zip(BATCH_GROUPS[group], arrays):
+                    if name in batched:
+                        cols[name][rows] = np.broadcast_to(arr, rows.shape)
     rest = [m for m in study.measures if m not in batched]
     if rest:
         for k, case_id in enumerate(ids):
             vehicle, speed_mps, kwargs = study.case(int(case_id))
-            doc = measure_set(vehicle, speed_mps, **kwargs).to_dict()
-            trim = doc.get("trim") or {}
-            doc["trim_delta_rad"], doc["trim_offtracking_m"] = trim.get("delta_rad"), trim.get("offtracking_m")
+            ms = measure_set(vehicle, speed_mps, **kwargs)
             for m in rest:
-                value = doc.get(m)
+                value = ms.value(m)
                 cols[m][k] = np.nan if value is None else float(value)
     return cols
 

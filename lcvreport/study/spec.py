@@ -21,7 +21,7 @@ tire coefficient), scale factors ``<unit>.mass_scale``, ``<unit>.yaw_inertia_sca
 ``.longitudinal_stiffness_scale`` (a unit name scales all its axles); load cases ``load_units``
 (values: lists of units carrying the 1 % rule, ``[]`` for none); residual sources ``P_<axle>_N``,
 ``T_<axle>_Nm``, ``eps_<axle>_rad`` (misalignment) and ``crossfall_percent`` (SPEC section 11;
-they act on the trim measures ``trim_delta_rad`` and ``trim_offtracking_m``).  A factor has ``values``
+they act on the trim measures ``trim.delta_rad`` and ``trim.offtracking_m``).  A factor has ``values``
 (a grid, or in a random design drawn with equal chance), or a ``distribution``: ``uniform``
 (``low``, ``high``) or ``normal`` (``mean``, ``sd``).  Cases are numbered from 0 in design order:
 the grid in the factors' file order (the last factor fastest); random draws per factor and per
@@ -47,22 +47,20 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.registry import BATCHED as _BATCH_GROUPS, CRITERIA_KEYS, unknown_key_message
 from ..model.vehicle import Vehicle, VehicleError
 from ..model.vehicle_file import dumps_vehicle, load_vehicle, loads_vehicle
 from ..ranges import RANGES, RangeError
 from ..units import kph_to_mps
 
-#: measures computed batched over the cases (lcvreport.analysis.batch); the others of
-#: ``lcv measures`` are computed case by case with measure_set (same numbers, slower)
-BATCHED = ("least_damping_ratio", "least_damped_frequency_hz", "critical_speed_kph", "ra_frequency",
-           "ra_single_sine", "ra_peak", "ra_peak_frequency_hz", "yaw_damping_coefficient", "hsto_m",
-           "ra_lane_change", "hsso_m", "steady_turn_delta_rad", "trim_delta_rad", "trim_offtracking_m")
-#: every measure a study can ask for: the scalar keys of ``lcv measures --json``
-MEASURES = BATCHED + ("lssp_m",
-                      "low_speed_offtracking_m", "max_tail_swing_m", "frontal_swing_m")
-DEFAULT_MEASURES = BATCHED[:-2]
-#: the trim's measures (``trim.delta_rad``, ``trim.offtracking_m`` of ``lcv measures``): need a source
-TRIM = ("trim_delta_rad", "trim_offtracking_m")
+#: measures computed batched over the cases (lcvreport.analysis.batch, the registry's BATCHED groups);
+#: the others of the registry are computed case by case with measure_set (same numbers, slower)
+BATCHED = tuple(k for keys in _BATCH_GROUPS.values() for k in keys)
+#: every measure a study can ask for: the scalar keys of the measure registry
+MEASURES = tuple(CRITERIA_KEYS)
+#: the trim's measures: need a residual source (a load case or a residual-source factor)
+TRIM = _BATCH_GROUPS["trim"]
+DEFAULT_MEASURES = tuple(k for k in BATCHED if k not in TRIM and k != "yaw_damping_lower_bound")
 UNIT_SCALES = {"mass_scale": "mass_kg", "yaw_inertia_scale": "yaw_inertia_kg_m2"}
 AXLE_SCALES = {"cornering_stiffness_scale": "cornering_stiffness_N_per_rad",
                "aligning_stiffness_scale": "aligning_stiffness_Nm_per_rad",
@@ -470,8 +468,11 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
     measures = doc.get("measures", list(DEFAULT_MEASURES))
     if not isinstance(measures, list) or not measures or any(m not in MEASURES for m in measures) or \
             len(set(measures)) != len(measures):
-        bad = next((m for m in measures if m not in MEASURES), measures) if isinstance(measures, list) else measures
-        raise StudyError(f"measures: {bad!r} is not a measure (or is repeated); valid: {', '.join(MEASURES)}")
+        bad = next((m for m in measures if m not in MEASURES), None) if isinstance(measures, list) else None
+        if isinstance(bad, str):
+            raise StudyError(f"measures: {unknown_key_message(bad, MEASURES)}")
+        raise StudyError(f"measures must be a list of distinct measure keys, got {measures!r}; valid: "
+                         f"{', '.join(MEASURES)}")
     design = doc.get("design", {})
     if not isinstance(design, dict):
         raise StudyError(f"design must be a table, got {design!r}")

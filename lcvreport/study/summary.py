@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.criteria import judge_values, lower_bounds_of
+
 QUANTILES = (0.0, 0.05, 0.5, 0.95, 1.0)
 
 
@@ -48,16 +50,6 @@ def wilson(passed: int, n: int, z: float = 1.959963984540054) -> tuple:
     return max(0.0, c - h), min(1.0, c + h)
 
 
-def _passes(values: np.ndarray, limit) -> np.ndarray:
-    v = np.abs(values) if limit.absolute else values
-    ok = np.ones(v.shape, bool)
-    if limit.min is not None:
-        ok &= v >= limit.min
-    if limit.max is not None:
-        ok &= v <= limit.max
-    return ok
-
-
 @dataclass
 class PassRates:
     """Pass rates of a study against limits: ``overall`` rows (per limit and all together) and
@@ -82,8 +74,7 @@ def pass_rates(table, criteria, factors, bins: int = 8) -> PassRates:
     pass_all = np.ones(len(table), bool)
     for lim in limits:
         x = table[lim.key].to_numpy(dtype=float)
-        judged = np.isfinite(x)
-        ok = judged & _passes(np.where(judged, x, 0.0), lim)
+        judged, ok = judge_values(lim, x, lower_bounds_of(table, lim.key))   # the verdicts of lcv measures
         verdict[lim.key] = (judged, ok)
         judged_all &= judged
         pass_all &= ok
