@@ -38,7 +38,7 @@ STOP, STEP, REPEATS = 10.0, 1e-3, 5
 TWIN_SLAVE = '''
 import ctypes
 
-from lcvreport.fmu.slave import LCV as _LCV
+from lcvreport.fmu.slave_fmi2 import LCV as _LCV
 
 
 class LCV(_LCV):

@@ -28,9 +28,16 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lcvreport import load_preset, load_vehicle  # noqa: E402
-from lcvreport.analysis import field_measures, measures  # noqa: E402
+from lcvreport.measures.offtracking import lane_change_measures, steady_turn
+from lcvreport.measures.amplification import ra_peak
+from lcvreport.measures.yaw_damping import yaw_damping_coefficient
+from lcvreport.analysis.frequency import RA_FREQUENCY_HZ, steer_to_acceleration
+from lcvreport.measures.stability import critical_speed, least_damping
+from lcvreport.measures.measure_set import measure_set
+from lcvreport.measures.amplification import single_sine
+from lcvreport.analysis.steady import trim
 from lcvreport.analysis.modes import state_matrix  # noqa: E402
-from lcvreport.model.loads import load_vector, one_percent_rule  # noqa: E402
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule  # noqa: E402
 from lcvreport.model.presets import PRESETS  # noqa: E402
 from lcvreport.units import kph_to_mps  # noqa: E402
 
@@ -65,17 +72,17 @@ def main() -> None:
         A = state_matrix(v, SPEED_MPS)
         F = load_vector(v, one_percent_rule(v, load))
         t_bare = best(lambda: np.linalg.eigvals(A))
-        t_all = best(lambda: measures.measure_set(v, SPEED_MPS, load_units=load))
+        t_all = best(lambda: measure_set(v, SPEED_MPS, load_units=load))
         parts = {
-            "damping": best(lambda: measures.least_damping(v, SPEED_MPS)),
-            "critical": best(lambda: measures.critical_speed(v)),
-            "RA(f)": best(lambda: measures.steer_to_acceleration(v, SPEED_MPS, measures.RA_FREQUENCY_HZ)),
-            "1-sine": best(lambda: measures.single_sine(v, SPEED_MPS)),
-            "trim": best(lambda: measures.trim(v, SPEED_MPS, F)),
-            "RApeak": best(lambda: field_measures.ra_peak(v, SPEED_MPS)),
-            "pulse": best(lambda: field_measures.yaw_damping_coefficient(v, SPEED_MPS)),
-            "lane": best(lambda: field_measures.lane_change_measures(v, SPEED_MPS)),
-            "turn": best(lambda: field_measures.steady_turn(v, SPEED_MPS)),
+            "damping": best(lambda: least_damping(v, SPEED_MPS)),
+            "critical": best(lambda: critical_speed(v)),
+            "RA(f)": best(lambda: steer_to_acceleration(v, SPEED_MPS, RA_FREQUENCY_HZ)),
+            "1-sine": best(lambda: single_sine(v, SPEED_MPS)),
+            "trim": best(lambda: trim(v, SPEED_MPS, F)),
+            "RApeak": best(lambda: ra_peak(v, SPEED_MPS)),
+            "pulse": best(lambda: yaw_damping_coefficient(v, SPEED_MPS)),
+            "lane": best(lambda: lane_change_measures(v, SPEED_MPS)),
+            "turn": best(lambda: steady_turn(v, SPEED_MPS)),
         }
         for k in ("pulse", "lane", "turn"):
             worst_part[k] = max(worst_part[k], parts[k])
@@ -136,7 +143,7 @@ def busy_core():
 def part2() -> None:
     v = load_preset("aucnat")
     load = [v.unit_names[-1]]
-    fn = lambda: measures.measure_set(v, SPEED_MPS, load_units=load)  # noqa: E731
+    fn = lambda: measure_set(v, SPEED_MPS, load_units=load)  # noqa: E731
     t_all, t_lapack, calls = lapack_replay(fn)
     print(f"measure_set of aucnat (6 units) at 88 km/h: {t_all * 1e3:.2f} ms; its {calls} linear-algebra calls "
           f"replayed alone: {t_lapack * 1e3:.2f} ms; ratio {t_all / t_lapack:.2f}  (target <= 3)")

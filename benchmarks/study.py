@@ -40,9 +40,14 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lcvreport import load_preset  # noqa: E402
-from lcvreport.analysis import field_measures, measures  # noqa: E402
+from lcvreport.measures.amplification import ra_peak
+from lcvreport.measures.offtracking import steady_turn
+from lcvreport.measures.stability import critical_speed, least_damping
+from lcvreport.measures.low_speed import low_speed_measures
+from lcvreport.measures.measure_set import measure_set
+from lcvreport.analysis.frequency import rearward_amplification
 from lcvreport.analysis.batch import VariantBatch  # noqa: E402
-from lcvreport.model.builder import system_coefficients  # noqa: E402
+from lcvreport.model.yaw_plane.equations import system_coefficients  # noqa: E402
 from lcvreport.units import kph_to_mps  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -288,7 +293,7 @@ class Twin:
         """The steered axle's lateral acceleration accel sin(2 pi f t) for one period, through each
         variant's inverse system; HSTO (the rear axle beyond the final offset) and max|a_N| / max|a_s|."""
         from scipy.linalg import expm
-        from lcvreport.analysis.geometry import point_lateral_map
+        from lcvreport.model.yaw_plane.outputs import point_lateral_map
         A, b = self._AB()
         B, n = b.shape
         v = self.v
@@ -354,16 +359,16 @@ def full_loop(vehicles):
     """Today's loop: measure_set per variant (its low-speed turn, a second model that a batch
     does not compute, taken out: cached per vehicle by a first call)."""
     for x in vehicles:
-        measures.measure_set(x, U)
+        measure_set(x, U)
 
 
 def loop_measures(vehicles):
     for x in vehicles:
-        measures.least_damping(x, U)
-        measures.critical_speed(x)
-        measures.rearward_amplification(x, U, F_RA)
-        field_measures.ra_peak(x, U)
-        field_measures.steady_turn(x, U)
+        least_damping(x, U)
+        critical_speed(x)
+        rearward_amplification(x, U, F_RA)
+        ra_peak(x, U)
+        steady_turn(x, U)
 
 
 def timed(fn):
@@ -395,7 +400,7 @@ def part1(B, n_loop, rounds):
           f"plain scan finds them: {np.array_equal(np.isnan(cb), np.isnan(ct))}")
     few = vehicles[:n_loop]
     for x in few:                                 # the low-speed turn once per vehicle (cached)
-        measures.low_speed_measures(x)
+        low_speed_measures(x)
     fb, ft, fl = [], [], []
     for _ in range(rounds):
         fb.append(timed(lambda: full_batch(batch))[0] / B)

@@ -26,8 +26,9 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lcvreport import load_preset  # noqa: E402
-from lcvreport.analysis.placement import place_tires  # noqa: E402
-from lcvreport.analysis.tracking import parse_distribution, sensitivities, tire_slots, tracking_stats  # noqa: E402
+from lcvreport.tracking.placement import place_tires  # noqa: E402
+from lcvreport.tracking.statistics import parse_distribution, tracking_stats  # noqa: E402
+from lcvreport.tracking.tires import sensitivities, tire_slots
 from lcvreport.units import kph_to_mps  # noqa: E402
 
 U = kph_to_mps(88.0)

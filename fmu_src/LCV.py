@@ -1,5 +1,5 @@
 """The slave module pythonfmu loads from the FMU's resources: the class is
-:class:`lcvreport.fmu.slave.LCV` of the package bundled next to this file, under a name of
+:class:`lcvreport.fmu.slave_fmi2.LCV` of the package bundled next to this file, under a name of
 its own (``lcvreport_fmu_<hash>``, written in by the build where ``lcvreport`` stands
 below), so a Python host that has imported another ``lcvreport`` -- another version, an
 editable checkout -- neither runs it nor is disturbed by it.
@@ -13,6 +13,6 @@ every time -- and gives back the one reference each execution takes away.
 """
 import ctypes
 
-from lcvreport.fmu.slave import LCV  # noqa: F401  (pythonfmu finds the Fmi2Slave class here)
+from lcvreport.fmu.slave_fmi2 import LCV
 
 ctypes.c_ssize_t.from_address(id(globals())).value += 1   # see (b) above: one per execution

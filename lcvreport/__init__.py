@@ -5,8 +5,8 @@ thesis form ``M x' = S x + F`` (J. J. Patterson, "Effect of conicity and ply ste
 long combination vehicle yaw plane motion", University of Akron, 2011), with the
 thesis reproduced and audited, the standard yaw-plane measures, FMUs and reports.
 
-Where things live (the folders are the layers; each imports only the ones above it)
-----------------------------------------------------------------------------------
+Where things live (a folder is a layer; each imports only the ones above it)
+---------------------------------------------------------------------------
 ``units``, ``ranges``    conversion factors and unit systems; the one table of valid
                          ranges of every parameter and input
 ``util/``                helpers with no physics:
@@ -14,34 +14,57 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``numerics``         numpy-only numerics: equilibrated solve, expm
     ``threads``          one BLAS thread at the entry points (LCV_BLAS_THREADS to change it)
     ``files``            the one guarded reader of every file a user hands in (regular files, a size limit, UTF-8)
-``model/``               **the model core** (numpy only):
+``model/``               **what a vehicle is, and the models of it** (numpy only):
     ``vehicle``          Axle, Unit, Vehicle (SI parameter sets, validated)
     ``vehicle_file``     vehicle files (TOML, SI): load_vehicle, dumps_vehicle
     ``presets``          the six thesis vehicles, shipped as vehicle files
-    ``builder``          M, S and the input matrices of any chain (SI or thesis units)
-    ``loads``            residual loads P, T; the 1 % rule; load conventions
-    ``low_speed``        the second model: low-speed plane kinematics (pull points, heading law; scipy)
     ``plausibility``     warnings for legal but implausible numbers (unit typos)
+    ``body``             the body of every unit: kind, extent, corners, overall length, poses
+    ``yaw_plane/``       the linear yaw-plane model of the thesis, ``M x' = S x + F``:
+        ``equations``    M, S and the input matrices of any chain (SI or thesis units)
+        ``states``       the state names and the joint letters
+        ``outputs``      point and rear-end lateral positions (eq. 4.42-4.46)
+        ``loads``        residual loads P, T and their sources; the 1 % rule; load conventions
+    ``low_speed/``       the low-speed kinematic model:
+        ``kinematics``   pull points, the heading law, the integration along a path (scipy)
+``manoeuvres/``          **what the driver and the road do**, independent of any model:
+    ``steer``            steer inputs as continuous functions (step, sine, pulse, table, lane change)
+    ``paths``            the paths of the low-speed model (straight, straight-arc-straight)
+    ``drivers``          the path-following preview driver
+``plotting/``            **figures** (matplotlib): they draw, they never compute; units on every axis
+    ``style``            page width, fonts, palette, a figure without pyplot state, figure data
+    ``vehicle``          top views, mode shapes, steady states
+    ``time``             time histories, the single sine, the lane change, the pulse
+    ``frequency``        eigenvalues, root loci, damping over speed, frequency responses
+    ``low_speed``        the swept path of the low-speed turn
+    ``tracking``         offtracking histogram, axle sensitivities, mounting study
+    ``study``            scatter and pass rates of a study
+    ``charts``           grouped bars and fitted curves
 ``analysis/``            **linear analysis** (numpy, scipy):
     ``modes``            eigenvalues, damping, mode shapes
-    ``steady``           steady state -S^-1 F
-    ``geometry``         rear-end offsets (eq. 4.42-4.46), global positions
-    ``manoeuvres``       steer inputs as continuous functions (step, sine, pulse, table, lane change)
-    ``exact``            exact response to them (augmented exponential), extrema between samples
-    ``field_measures``   RA peak, yaw damping (PBS style), HSTO, HSSO (SPEC 12)
-    ``low_speed_turn``   the low-speed 90° turn: swept width, offtracking, tail and frontal swing (SPEC 16)
-    ``driver``           a path-following driver with preview, the closed loop of vehicle and driver
-    ``batch``            variants of a vehicle in a batch: matrices and damping over the leading axis
-    ``registry``         every measure once: key, label, unit, definition, limit kind, how it is batched
-    ``criteria``         the user's limits and the verdicts
-    ``tracking``         per-tire conicity and ply steer, fleet statistics of the trimmed offtracking
-    ``placement``        which measured tire goes where: the exact mounting plan (a mixed-integer program)
-    ``discretize``       exact zero-order-hold discretization, its cache
+    ``steady``           steady state -S^-1 F, the steady state with a held yaw rate, the trim
+    ``frequency``        G(j w) from the steer to every unit's acceleration, RA(f)
+    ``exact``            exact response to steer inputs (augmented exponential)
+    ``extrema``          extrema between samples (Hermite), the doubling scan
     ``response``         TimeResponse, simulate, step_response (exact)
+    ``discretize``       exact zero-order-hold discretization, its cache
     ``modal``            modal superposition, exact and the thesis' method
     ``statespace``       named state space; to_statespace (python-control)
-    ``measures``         RA, damping, critical speed, single sine, trim
-    ``closed_loop``      sampled steering feedback (what a co-simulation computes)
+    ``closed_loop``      the vehicle with a driver: continuous, and sampled steering feedback
+    ``batch``            variants of a vehicle in a batch: matrices and responses over the leading axis
+``measures/``            **the field's measures**, one family per module:
+    ``registry``         every measure once: key, label, unit, definition, limit kind, how it is batched
+    ``stability``        least damping, critical speed, speed sweep
+    ``amplification``    single-sine RA, the RA peak
+    ``yaw_damping``      yaw damping coefficient (ratio method)
+    ``offtracking``      HSTO and RA of the lane change, HSSO
+    ``low_speed``        the low-speed 90-degree turn: swept width, offtracking, tail and frontal swing
+    ``measure_set``      every measure of a vehicle at a speed (MeasureSet)
+    ``criteria``         the user's limits and the verdicts
+``tracking/``            **straight-line tracking** over a tire population:
+    ``tires``            tire slots, per-axle residuals, sensitivities, the mounted-tires file
+    ``statistics``       fleet statistics of the trimmed offtracking
+    ``placement``        which measured tire goes where: the exact mounting plan (a mixed-integer program)
 ``thesis/``              **the reproduction of the dissertation**:
     ``tables``           its tables and gaps (data files in ``data/thesis``)
     ``tires``            cubic fits of the tire coefficients against load
@@ -49,31 +72,47 @@ Where things live (the folders are the layers; each imports only the ones above 
     ``configurations``   per-tire residual forces (Figures 3-6..3-8, 4-9..4-11)
     ``studies``          the chapter III-V runs, in both readings
     ``tracking_questions`` chapter VI's open questions on straight-line tracking, answered on AU-NCAT
+    ``figures``          its own figures: free body, load configurations, tire curves and fits
     ``audit``            every published number against its recomputation
 ``fmu/``                 **the FMUs**:
-    ``interface``        the one interface table (SPEC sections 5 and 9)
-    ``model_description`` modelDescription.xml from that table
-    ``model_description3`` the FMI 3.0 modelDescription.xml and buildDescription.xml
-    ``driver``           the driver FMU (FMI 2.0 CS and ME, C99) of analysis.driver
+    ``interface``        the one interface table of every FMU
+    ``description_common`` what both modelDescription.xml versions share
+    ``description_fmi2`` the FMI 2.0 modelDescription.xml
+    ``description_fmi3`` the FMI 3.0 modelDescription.xml and buildDescription.xml
+    ``driver``           the driver FMU (FMI 2.0 CS and ME, C99) of the preview driver
     ``engine``           the co-simulation engine (numpy only)
     ``slave_core``       what the Python FMUs compute, FMI calls by value reference onto the engine
-    ``slave``            the FMI 2.0 slave class: the core behind pythonfmu
-    ``slave3``           the FMI 3.0 slave class: the core behind pythonfmu3
-    ``build``            builders of the pythonfmu and the C FMU (sources in the
+    ``slave_fmi2``       the FMI 2.0 slave class: the core behind pythonfmu
+    ``slave_fmi3``       the FMI 3.0 slave class: the core behind pythonfmu3
+    ``c_sources``        generated C headers, the source lists, the compiler call
+    ``package``          documentation, licences, the package copy, the zip
+    ``build``            builders of the pythonfmu and the C FMUs (sources in the
                          repository's ``fmu_src/``, installed as ``lcvreport.fmu_src``)
-``study/``               **studies at scale** (SPEC section 14; pandas, pyarrow, dask on use):
+``study/``               **studies at scale** (pandas, pyarrow, dask on use):
     ``spec``             the study file: vehicle, factors, design, measures; the cases
     ``compute``          the measures of a chunk of cases, batched over the cases
+    ``folder``           the study folder's files and chunk names
     ``run``              ``lcv study``: chunks on Dask, Parquet written atomically, resume
     ``results``          ``read_study`` (one table) and ``study_case`` (a row as a measure_set call)
     ``summary``          spread of the measures, pass rates against criteria (the study report)
 ``report/``              **the reports** (notebooks in ``notebooks/``, installed as
                          ``lcvreport.notebooks``):
-    ``plotting``         figures (matplotlib), units on every axis
-    ``reporting``        captions, tables (HTML, LaTeX), CSV of every table and figure
+    ``tables``           captions, tables (HTML, LaTeX), CSV of every table and figure
     ``assessment``       what the assessment report of one vehicle shows
-    ``build``            papermill + nbconvert: the thesis report, the assessment report
-``cli``                  the ``lcv`` command (``_entry``: its console script, one BLAS thread first)
+    ``notebooks``        notebook parameters and their checks, execution, merge, HTML and PDF export
+    ``publish``          output folder checks, staging, manifest, atomic publish
+    ``build``            the thesis report, the assessment report, the study report
+``cli/``                 **the ``lcv`` command**, one module per command group (``__main__``: ``python -m lcvreport.cli``):
+    ``main``             the parser, dispatch and exit statuses
+    ``options``          the options the commands share (vehicle, speed, loads, residual sources)
+    ``output``           the output stream and figures written aside
+    ``model``            presets, eig, matrices, steady
+    ``simulate``         simulate
+    ``measures``         measures (text, CSV, JSON from the registry)
+    ``tracking``         tracking place, tracking stats
+    ``turn``             the low-speed turn
+    ``artifacts``        fmu, report, study
+``_entry``               the console script (one BLAS thread first)
 
 Units
 -----
@@ -107,15 +146,15 @@ _API = {
     "load_vehicle": "model.vehicle_file", "loads_vehicle": "model.vehicle_file",
     "VehicleFileError": "model.vehicle_file", "dumps_vehicle": "model.vehicle_file",
     "PRESETS": "model.presets", "load_preset": "model.presets",
-    "system_coefficients": "model.builder", "system_matrices": "model.builder",
-    "ResidualLoads": "model.loads", "one_percent_rule": "model.loads", "load_vector": "model.loads",
+    "system_coefficients": "model.yaw_plane.equations", "system_matrices": "model.yaw_plane.equations",
+    "ResidualLoads": "model.yaw_plane.loads", "one_percent_rule": "model.yaw_plane.loads", "load_vector": "model.yaw_plane.loads",
     "Modes": "analysis.modes", "modes": "analysis.modes", "eigenvalues": "analysis.modes",
     "steady_state": "analysis.steady",
     "TimeResponse": "analysis.response", "simulate": "analysis.response", "step_response": "analysis.response",
     "to_statespace": "analysis.statespace",
-    "measure_set": "analysis.measures", "rearward_amplification": "analysis.measures",
-    "critical_speed": "analysis.measures", "least_damping": "analysis.measures", "single_sine": "analysis.measures",
-    "trim": "analysis.measures",
+    "measure_set": "measures.measure_set", "rearward_amplification": "analysis.frequency",
+    "critical_speed": "measures.stability", "least_damping": "measures.stability", "single_sine": "measures.amplification",
+    "trim": "analysis.steady",
     "read_study": "study.results", "study_case": "study.results", "load_study": "study.spec",
     "run_study": "study.run",
 }

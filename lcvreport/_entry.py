@@ -1,10 +1,10 @@
 """The ``lcv`` console script: one BLAS thread unless told otherwise (:mod:`lcvreport.util.threads`),
-set before numpy is imported, then :func:`lcvreport.cli.main`."""
+set before numpy is imported, then :func:`lcvreport.cli.main.main`."""
 from __future__ import annotations
 
 
 def main() -> None:
     from .util.threads import configure_entry_point
     configure_entry_point()
-    from .cli import main as cli_main
+    from .cli.main import main as cli_main
     cli_main()

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from lcvreport.analysis.discretize import augmented_state_matrix, discretize
 from lcvreport.fmu.engine import LCVEngine
-from lcvreport.model.builder import system_coefficients
+from lcvreport.model.yaw_plane.equations import system_coefficients
 from lcvreport.model.vehicle import Axle, Unit, Vehicle
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -7,7 +7,7 @@ import pytest
 
 from lcvreport import load_preset, load_vehicle
 from lcvreport.analysis.batch import AXLE_PARAMETERS, UNIT_PARAMETERS, BatchError, VariantBatch, _nominal, _with
-from lcvreport.analysis.measures import least_damping
+from lcvreport.measures.stability import least_damping
 from lcvreport.analysis.modes import eigenvalues, state_matrix
 
 from conftest import EXAMPLES
@@ -58,7 +58,7 @@ def test_bad_batches_are_refused():
 def test_batched_critical_speed_equals_the_one_variant_algorithm(tire_scale):
     """Masses and C_F varied ±40 % on the empty triple: unstable and stable variants alike,
     the same critical speed (to its 0.1 km/h) as measures.critical_speed of each variant."""
-    from lcvreport.analysis.measures import critical_speed
+    from lcvreport.measures.stability import critical_speed
     v = load_preset("empty")
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(14)
@@ -75,7 +75,7 @@ def test_batched_critical_speed_equals_the_one_variant_algorithm(tire_scale):
 
 
 def test_batched_gains_and_rearward_amplification():
-    from lcvreport.analysis.measures import rearward_amplification, steer_to_acceleration
+    from lcvreport.analysis.frequency import rearward_amplification, steer_to_acceleration
     v = load_preset("aucnat")
     names = [f"{u.name}.yaw_inertia_kg_m2" for u in v.units] + [f"{a.name}.aligning_stiffness_Nm_per_rad"
                                                                  for a in v.axles]
@@ -93,8 +93,8 @@ def test_batched_gains_and_rearward_amplification():
 
 def test_batched_trim_equals_the_one_variant_trim():
     """Residual forces and moments on the last two trailers (1 % rule), C_F and masses varied."""
-    from lcvreport.analysis.measures import trim
-    from lcvreport.model.loads import load_vector, one_percent_rule
+    from lcvreport.analysis.steady import trim
+    from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
     v = load_preset("aucnat")
     F = load_vector(v, one_percent_rule(v, ["trailer2", "trailer3"]))
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
@@ -110,7 +110,7 @@ def test_batched_trim_equals_the_one_variant_trim():
 
 
 def test_batched_steady_turn_equals_hsso():
-    from lcvreport.analysis.field_measures import steady_turn
+    from lcvreport.measures.offtracking import steady_turn
     v = load_vehicle(EXAMPLES / "western_double.toml")
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(11)
@@ -126,7 +126,7 @@ def test_batched_steady_turn_equals_hsso():
 def test_batched_ra_peak_equals_the_one_variant_peak():
     """The value to 1e-12; where it is to 1e-10: both locate the zero of the exact slope (a
     search on RA's values alone would find a smooth maximum to about sqrt(eps) only)."""
-    from lcvreport.analysis.field_measures import ra_peak
+    from lcvreport.measures.amplification import ra_peak
     v = load_preset("aucnat")
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(2)
@@ -174,7 +174,7 @@ def test_batched_single_sine_is_the_one_variant_single_sine(preset, speed):
     """RA of the single sine on the continuous exact response, every variant at once (in groups
     of 64), against measures.single_sine of each variant built on its own: 1e-12 relative (what
     differs is the scaling the matrix exponential chooses for the smaller augmented matrices)."""
-    from lcvreport.analysis.measures import single_sine
+    from lcvreport.measures.amplification import single_sine
     v = load_preset(preset)
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(9)
@@ -192,7 +192,7 @@ def test_batched_yaw_damping_is_the_one_variant_coefficient(preset, speed):
     every variant at once against field_measures.yaw_damping_coefficient of each.  1e-11
     relative: d = ln(P_i / P_(i+1)) of peak-to-peak amplitudes takes the extrema's rounding
     (1e-14 of the peaks, located by different exponentials' scalings) to about 1e-12."""
-    from lcvreport.analysis.field_measures import yaw_damping_coefficient
+    from lcvreport.measures.yaw_damping import yaw_damping_coefficient
     v = load_preset(preset)
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(10)
@@ -211,7 +211,7 @@ def test_batched_yaw_damping_is_the_one_variant_coefficient(preset, speed):
 def test_batched_lane_change_is_the_one_variant_lane_change(preset, speed):
     """HSTO and the lane change's RA through every variant's inverse system at once, against
     field_measures.lane_change_measures of each: 1e-12 relative (HSTO absolute 1e-12 m where 0)."""
-    from lcvreport.analysis.field_measures import lane_change_measures
+    from lcvreport.measures.offtracking import lane_change_measures
     v = load_preset(preset)
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(11)
@@ -228,7 +228,7 @@ def test_a_variant_with_an_unstable_inverse_system_has_no_lane_change():
     """legal_max at 60 m/s has a right-half-plane zero (exact.response refuses the lane change,
     measure_set reports null): its variants get NaN, the others their numbers."""
     from lcvreport.analysis.exact import ManoeuvreError
-    from lcvreport.analysis.field_measures import lane_change_measures
+    from lcvreport.measures.offtracking import lane_change_measures
     v = load_preset("legal_max")
     name = f"{v.units[0].name}.yaw_inertia_kg_m2"
     values = {name: _nominal(v, name) * np.array([1.0, 1.0])}
@@ -242,7 +242,7 @@ def test_a_variant_with_an_unstable_inverse_system_has_no_lane_change():
 
 def test_the_grouped_ratio_method_equals_the_one_signal_method():
     from lcvreport.analysis.batch import ratio_damping_groups
-    from lcvreport.analysis.field_measures import ratio_damping
+    from lcvreport.measures.yaw_damping import ratio_damping
     rng = np.random.default_rng(7)
     groups, signals, values, expected = [], [], [], {}
     for g in range(40):

@@ -14,12 +14,12 @@ import time
 import numpy as np
 import pytest
 
-from lcvreport.analysis.geometry import rear_offsets
+from lcvreport.model.yaw_plane.outputs import rear_offsets
 from lcvreport.analysis.modes import eigenvalues
 from lcvreport.analysis.steady import steady_state
-from lcvreport.cli import EXIT_BROKEN_PIPE, run
-from lcvreport.model.builder import system_matrices
-from lcvreport.model.loads import load_vector, one_percent_rule
+from lcvreport.cli.main import EXIT_BROKEN_PIPE, run
+from lcvreport.model.yaw_plane.equations import system_matrices
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
 from lcvreport.model.presets import PRESETS, load_preset
 from lcvreport.model.vehicle_file import load_vehicle
 from lcvreport.ranges import RANGES

@@ -13,7 +13,8 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Model, FMU2Slave
 
-from lcvreport.analysis.driver import DEFAULT, PreviewDriver, closed_loop
+from lcvreport.manoeuvres.drivers import DEFAULT, PreviewDriver
+from lcvreport.analysis.closed_loop import closed_loop
 from lcvreport.fmu.driver import build_driver_fmu
 from lcvreport.fmu.interface import preset_value
 from lcvreport.model.presets import load_preset

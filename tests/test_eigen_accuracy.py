@@ -9,7 +9,7 @@ import pytest
 import scipy.linalg
 
 from lcvreport.analysis.modes import eigenvalues, modes
-from lcvreport.model.builder import system_coefficients
+from lcvreport.model.yaw_plane.equations import system_coefficients
 
 from helpers import random_vehicle
 

@@ -17,8 +17,8 @@ from lcvreport.analysis.discretize import Discretizer
 from lcvreport.analysis.modal import modal_response
 from lcvreport.analysis.response import iter_step_response, simulate, step_response
 from lcvreport.analysis.steady import steady_state
-from lcvreport.model.builder import system_coefficients
-from lcvreport.model.loads import load_vector, one_percent_rule
+from lcvreport.model.yaw_plane.equations import system_coefficients
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
 from lcvreport.model.presets import PRESETS, load_preset
 from lcvreport.model.vehicle_file import load_vehicle
 from lcvreport.units import THESIS, mph_to_mps

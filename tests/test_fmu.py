@@ -18,7 +18,7 @@ from fmpy import simulate_fmu
 from lcvreport.analysis.modes import eigenvalues
 from lcvreport.fmu.engine import LCVEngine
 from lcvreport.fmu.interface import preset_interface, preset_value
-from lcvreport.model.builder import system_coefficients
+from lcvreport.model.yaw_plane.equations import system_coefficients
 from lcvreport.model.presets import PRESETS, load_preset
 
 from fmu_support import Slave, run_schedule
@@ -380,7 +380,7 @@ def test_a_misalignment_input_drives_the_fmu_to_the_packages_steady_state(preset
     """eps<axle> (SPEC 11 misalignment) held: the FMU settles where the package's
     residual sources put the model, -S^-1 F (a steady circle), whatever the kind of FMU."""
     from lcvreport.analysis.steady import steady_state
-    from lcvreport.model.loads import ResidualSources
+    from lcvreport.model.yaw_plane.loads import ResidualSources
     v = load_preset("aucnat")
     s = Slave(preset_fmu, preset="aucnat", tire_scale=0.8).init()
     s.set(eps41=0.002, eps21=-0.001, u=20.0)
@@ -405,7 +405,7 @@ def test_a_misalignment_beyond_the_range_is_refused(preset_fmu):
 
 def test_the_crossfall_parameter_drives_the_fmu_to_the_packages_steady_state(preset_fmu):
     from lcvreport.analysis.steady import steady_state
-    from lcvreport.model.loads import ResidualSources
+    from lcvreport.model.yaw_plane.loads import ResidualSources
     v = load_preset("aucnat")
     s = Slave(preset_fmu, preset="aucnat", crossfall=-3.0).init()
     s.set(u=25.0, eps61=0.001)

@@ -95,7 +95,7 @@ def test_the_guarded_reader_reads_a_file_with_a_byte_order_mark(tmp_path):
     assert p.returncode == 0, p.stderr
     tires = tmp_path / "measured.csv"
     tires.write_text("\ufeffid,conicity_N,ply_steer_N\nA,10,5\nB,-10,5\n", encoding="utf-8")
-    from lcvreport.analysis.placement import read_measured_tires
+    from lcvreport.tracking.placement import read_measured_tires
     assert [t["id"] for t in read_measured_tires(tires)] == ["A", "B"]
 
 
@@ -229,7 +229,7 @@ def test_a_flipped_byte_in_a_chunk_is_caught_by_its_page_checksum(tmp_path):
 
 
 def test_a_full_disk_while_the_folder_is_set_up_leaves_nothing_the_rerun_refuses(tmp_path, monkeypatch):
-    import lcvreport.study.run as run
+    from lcvreport.study.run import run_study
     s, out = _small(), tmp_path / "out"
     real = Path.write_text
 
@@ -240,10 +240,10 @@ def test_a_full_disk_while_the_folder_is_set_up_leaves_nothing_the_rerun_refuses
         return real(self, text, *a, **k)
     monkeypatch.setattr(Path, "write_text", full)
     with pytest.raises(OSError):
-        run.run_study(s, out)
+        run_study(s, out)
     monkeypatch.setattr(Path, "write_text", real)
     assert not list(out.glob(".*.tmp")) and not (out / "manifest.json").exists()
-    assert run.run_study(s, out).n_computed == 3
+    assert run_study(s, out).n_computed == 3
     assert len(read_study(out)) == 12
 
 
@@ -467,7 +467,7 @@ def test_the_peak_steer_of_the_refusal_is_the_continuous_responses():
     """The refusal's number is max|delta| of the inverse system's output (against a fine sample)."""
     from lcvreport import load_preset
     from lcvreport.analysis.exact import ManoeuvreError, check_lane_change_steer, response
-    from lcvreport.analysis.manoeuvres import parse_steer
+    from lcvreport.manoeuvres.steer import parse_steer
     v, u = load_preset("aucnat"), 20 / 3.6
     r = response(v, u, parse_steer("lane-change:2g:0.4"), 10.0, 1e-3)
     fine = float(np.abs(r["delta"]).max())

@@ -15,8 +15,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lcvreport import PRESETS, load_preset, load_vehicle, measure_set
-from lcvreport.analysis.low_speed_turn import TurnError, low_speed_turn, overall_length_m
-from lcvreport.model.low_speed import StraightArcPath, StraightPath, integrate
+from lcvreport.model.body import TurnError, overall_length_m
+from lcvreport.measures.low_speed import low_speed_turn
+from lcvreport.manoeuvres.paths import StraightArcPath, StraightPath
+from lcvreport.model.low_speed.kinematics import integrate
 from lcvreport.model.vehicle import Axle, Unit, Vehicle, VehicleError
 from lcvreport.model.vehicle_file import VehicleFileError, loads_vehicle
 

@@ -14,14 +14,18 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from lcvreport import load_preset, load_vehicle
-from lcvreport.analysis import field_measures as fm
+from lcvreport.measures.offtracking import HSSO_RADIUS_M, steady_turn
+from lcvreport.measures.amplification import ra_peak
+from lcvreport.measures.yaw_damping import ratio_damping, yaw_damping_coefficient
 from lcvreport.analysis.discretize import augmented_state_matrix
 from lcvreport.analysis.exact import ManoeuvreError, response
-from lcvreport.analysis.manoeuvres import (G_MPS2, SteerError, lane_change, lane_change_offset_m, parse_steer, pulse,
-                                           sine, step, table)
-from lcvreport.analysis.measures import measure_set, steer_to_acceleration, trim
-from lcvreport.model.builder import system_coefficients
-from lcvreport.model.loads import ResidualLoads, ResidualSources
+from lcvreport.manoeuvres.steer import (G_MPS2, SteerError, lane_change, lane_change_offset_m, parse_steer, pulse, sine,
+                                        step, table)
+from lcvreport.measures.measure_set import measure_set
+from lcvreport.analysis.frequency import steer_to_acceleration
+from lcvreport.analysis.steady import trim
+from lcvreport.model.yaw_plane.equations import system_coefficients
+from lcvreport.model.yaw_plane.loads import ResidualLoads, ResidualSources
 
 from conftest import EXAMPLES
 from helpers import chain_on_circle_by_root_finding
@@ -107,7 +111,7 @@ def test_a_lane_change_the_inverse_system_cannot_follow_is_refused(tmp_path):
 @pytest.mark.parametrize("name", ["tractor_semitrailer", "aucnat"])
 def test_ra_peak_equals_a_brute_force_grid(name):
     v = load_preset(name)
-    p = fm.ra_peak(v, U88)
+    p = ra_peak(v, U88)
     f = np.arange(0.1, 2.0 + 5e-6, 1e-5)
     G = np.abs(steer_to_acceleration(v, U88, f))
     ra = G[:, -1] / G[:, 0]
@@ -125,7 +129,7 @@ def test_ra_peak_frequency_is_the_vertex_of_an_independent_parabola(name, kph):
     # third derivative ~h^2, rounding ~eps/h); a search on RA's values alone stops ~1e-8 away
     v = load_preset(name)
     u = kph / 3.6
-    p = fm.ra_peak(v, u)
+    p = ra_peak(v, u)
     h = 1e-5
     G = np.abs(steer_to_acceleration(v, u, p.frequency_hz + np.array([-h, 0.0, h])))
     r = G[:, -1] / G[:, 0]
@@ -139,9 +143,9 @@ def test_ra_peak_falls_back_to_a_value_search_where_the_slope_brackets_no_zero(m
     # own precision, ~sqrt(eps) of the frequency on a flat maximum)
     import scipy.linalg
     v = load_preset("aucnat")
-    p = fm.ra_peak(v, U88)
+    p = ra_peak(v, U88)
     monkeypatch.setattr(scipy.linalg, "lu_solve", lambda lu, b: np.full(np.shape(b), np.nan, dtype=complex))
-    q = fm.ra_peak(v, U88)
+    q = ra_peak(v, U88)
     assert q.value == pytest.approx(p.value, rel=1e-13)
     assert abs(q.frequency_hz - p.frequency_hz) <= 1e-7
 
@@ -150,7 +154,7 @@ def test_the_ratio_method_of_one_damped_mode_is_its_modal_damping_ratio():
     for lam in (-0.3 + 2.0j, -1.2 + 7.5j, -0.05 + 0.9j):
         t = (np.arange(9) * np.pi - np.angle(lam)) / lam.imag        # extrema of exp(sigma t) sin(omega t)
         values = np.exp(lam.real * t) * np.sin(lam.imag * t)
-        zeta, P = fm.ratio_damping(values)
+        zeta, P = ratio_damping(values)
         assert zeta == pytest.approx(-lam.real / abs(lam), rel=1e-12)
         assert P.size == min(6, int(np.sum(np.abs(np.diff(values)) >= 0.05 * np.abs(np.diff(values)).max())))
 
@@ -159,7 +163,7 @@ def test_yaw_damping_extrema_equal_those_of_a_stiff_ode_solve():
     """The extrema of each articulation angle after the pulse (zeros of theta' on the
     continuous response) against brentq on a Radau dense output."""
     v = load_preset("tractor_semitrailer")
-    ydc = fm.yaw_damping_coefficient(v, U88)
+    ydc = yaw_damping_coefficient(v, U88)
     steer = pulse(0.01, 0.5)
     co = system_coefficients(v)
     A, G = augmented_state_matrix(co, U88)
@@ -182,18 +186,18 @@ def test_yaw_damping_extrema_equal_those_of_a_stiff_ode_solve():
     np.testing.assert_allclose(times[:n], roots[:n], rtol=0, atol=1e-9)
     np.testing.assert_allclose(values[:n], [sol.sol(t)[j] for t in roots[:n]], rtol=0,
                                atol=1e-9 * np.abs(values).max())
-    assert ydc.value == pytest.approx(fm.ratio_damping([sol.sol(t)[j] for t in roots])[0], rel=1e-8)
+    assert ydc.value == pytest.approx(ratio_damping([sol.sol(t)[j] for t in roots])[0], rel=1e-8)
 
 
 @pytest.mark.parametrize("name", ["aucnat", "b_double"])
 def test_hsso_equals_a_long_run_holding_the_turns_steer(name):
     v = load_preset(name) if name == "aucnat" else load_vehicle(EXAMPLES / f"{name}.toml")
-    turn = fm.steady_turn(v, U88)
+    turn = steady_turn(v, U88)
     r = response(v, U88, step(turn.delta_rad), 300.0, 0.5)
     co = system_coefficients(v)
     x = np.array([r[n][-1] for n in v.state_names])
     omega = r["r1"][-1]
-    assert U88 / omega == pytest.approx(fm.HSSO_RADIUS_M, rel=1e-6)        # the radius read off the run
+    assert U88 / omega == pytest.approx(HSSO_RADIUS_M, rel=1e-6)        # the radius read off the run
     vel = co.velocity_map(U88) @ x
     steered = max(v.steered_axles, key=lambda a: a.x_m)
     rear = v.units[-1].rearmost_axle
@@ -292,7 +296,7 @@ def test_criteria_give_verdicts_with_their_source(tmp_path):
 
 
 def test_the_example_criteria_file_loads_and_says_it_is_not_a_standard():
-    from lcvreport.analysis.criteria import load_criteria
+    from lcvreport.measures.criteria import load_criteria
     path = EXAMPLES.parent / "criteria" / "example_limits.toml"
     c = load_criteria(path)
     assert c.limits and all("not a standard" in lim.source for lim in c.limits.values())

@@ -11,15 +11,20 @@ import control
 import numpy as np
 import pytest
 
-from lcvreport.analysis import measures
+from lcvreport.measures.stability import U_MIN_DEFAULT_MPS, critical_speed, least_damping
+from lcvreport.tracking.tires import conicity_sensitivity
+from lcvreport.measures.measure_set import measure_set
+from lcvreport.analysis.frequency import rearward_amplification, steer_to_acceleration
+from lcvreport.analysis.steady import reference_points, trim
+from lcvreport.measures.amplification import single_sine
 from lcvreport.analysis.discretize import augmented_state_matrix, discretize
-from lcvreport.analysis.geometry import global_lateral, point_longitudinal
+from lcvreport.model.yaw_plane.outputs import global_lateral, point_longitudinal
 from lcvreport.analysis.modes import eigenvalues
 from lcvreport.analysis.response import simulate
 from lcvreport.analysis.statespace import to_statespace
 from lcvreport.analysis.steady import steady_state
-from lcvreport.model.builder import system_coefficients
-from lcvreport.model.loads import load_vector, one_percent_rule
+from lcvreport.model.yaw_plane.equations import system_coefficients
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
 from lcvreport.model.presets import PRESETS, load_preset
 from lcvreport.model.vehicle_file import load_vehicle
 from lcvreport.units import kph_to_mps, mps_to_kph
@@ -42,8 +47,8 @@ def test_ra_at_low_frequency_tends_to_the_steady_state_gain_ratio(semi):
     a_ss = U88 * x[1:semi.n_units + 1]
     ratio = abs(a_ss[-1] / a_ss[0])
     assert ratio == pytest.approx(1.0, rel=1e-12)
-    d1 = measures.rearward_amplification(semi, U88, 0.01) - ratio
-    d2 = measures.rearward_amplification(semi, U88, 0.02) - ratio
+    d1 = rearward_amplification(semi, U88, 0.01) - ratio
+    d2 = rearward_amplification(semi, U88, 0.02) - ratio
     assert abs(d1) < 1e-3
     assert d2 / d1 == pytest.approx(4.0, rel=0.02)          # second order in f
 
@@ -83,8 +88,8 @@ def test_ra_equals_the_amplitude_ratio_of_a_long_exact_sine_run(name):
     tail = t >= T - 10.0          # four whole periods, transients gone (slowest time constant < 2 s)
     basis = np.column_stack([np.sin(2 * np.pi * f * t[tail]), np.cos(2 * np.pi * f * t[tail])])
     amp = np.linalg.norm(np.linalg.lstsq(basis, a[tail], rcond=None)[0], axis=0)
-    assert amp[-1] / amp[0] == pytest.approx(measures.rearward_amplification(v, U88), rel=1e-7)
-    gains = np.abs(measures.steer_to_acceleration(v, U88, f))
+    assert amp[-1] / amp[0] == pytest.approx(rearward_amplification(v, U88), rel=1e-7)
+    gains = np.abs(steer_to_acceleration(v, U88, f))
     np.testing.assert_allclose(amp / 0.01, gains, rtol=1e-7)
 
 
@@ -98,7 +103,7 @@ def test_to_statespace_agrees_with_the_measures(name):
         ay = sys_.output_labels.index(f"ay{i + 1}")
         G = resp.magnitude[ay, sys_.input_labels.index("delta")] * np.exp(
             1j * resp.phase[ay, sys_.input_labels.index("delta")])
-        np.testing.assert_allclose(G, measures.steer_to_acceleration(v, U88, f)[:, i], rtol=1e-10)
+        np.testing.assert_allclose(G, steer_to_acceleration(v, U88, f)[:, i], rtol=1e-10)
     # the DC gain of the states is the steady state
     x_ss = steady_state(v, U88, system_coefficients(v).B_delta())
     dc = control.dcgain(sys_)[:v.n_states, 0]
@@ -127,7 +132,7 @@ def test_single_sine_is_the_response_to_the_continuous_sine_with_its_peaks_betwe
     from scipy.integrate import solve_ivp
     from scipy.optimize import minimize_scalar
     v = _vehicle(name)
-    ss = measures.single_sine(v, U88)
+    ss = single_sine(v, U88)
     co = system_coefficients(v)
     A, G = co.state_derivative_maps(U88)
     b = G @ co.B_delta()
@@ -158,7 +163,7 @@ def test_single_sine_is_the_response_to_the_continuous_sine_with_its_peaks_betwe
 
 
 def test_single_sine_ra_does_not_depend_on_the_amplitude(aucnat):
-    ras = [measures.single_sine(aucnat, U88, delta0_rad=d).rearward_amplification for d in (1e-4, 0.01, 0.2)]
+    ras = [single_sine(aucnat, U88, delta0_rad=d).rearward_amplification for d in (1e-4, 0.01, 0.2)]
     np.testing.assert_allclose(ras, ras[0], rtol=1e-12)
 
 
@@ -166,8 +171,8 @@ def test_single_sine_ra_does_not_depend_on_the_amplitude(aucnat):
 @pytest.mark.parametrize("name, tire_scale", [("empty", 0.2), ("legal_max", 0.2), ("empty", 0.05)])
 def test_critical_speed_equals_a_dense_eigenvalue_scan(name, tire_scale):
     v = load_preset(name)
-    crit = measures.critical_speed(v, tire_scale)
-    lo = mps_to_kph(measures.U_MIN_DEFAULT_MPS)
+    crit = critical_speed(v, tire_scale)
+    lo = mps_to_kph(U_MIN_DEFAULT_MPS)
     scan = np.arange(lo, 200.0, 0.01)
     unstable = eigenvalues(v, kph_to_mps(scan), tire_scale).real.max(axis=-1) >= 0
     first = scan[np.argmax(unstable)]
@@ -178,12 +183,12 @@ def test_critical_speed_equals_a_dense_eigenvalue_scan(name, tire_scale):
 @pytest.mark.parametrize("name", ["aucnat", "tractor_semitrailer"] + list(EXAMPLE_NAMES))
 def test_stable_vehicles_have_no_critical_speed(name):
     v = _vehicle(name)
-    assert measures.critical_speed(v) is None
+    assert critical_speed(v) is None
     assert eigenvalues(v, kph_to_mps(np.linspace(8.1, 200, 50))).real.max() < 0
 
 
 def test_least_damping_is_the_least_damped_oscillatory_mode(aucnat):
-    zeta, f = measures.least_damping(aucnat, U88)
+    zeta, f = least_damping(aucnat, U88)
     lam = eigenvalues(aucnat, U88)
     osc = lam[lam.imag > 0]
     k = np.argmin(-osc.real / np.abs(osc))
@@ -196,7 +201,7 @@ def test_least_damping_is_the_least_damped_oscillatory_mode(aucnat):
 def test_trimmed_state_is_straight_and_steady(name):
     v = _vehicle(name)
     F = load_vector(v, one_percent_rule(v, [v.unit_names[-1], v.unit_names[0]]))
-    tr = measures.trim(v, U88, F)
+    tr = trim(v, U88, F)
     co = system_coefficients(v)
     xdot = np.linalg.solve(co.M(U88), co.S(U88) @ tr.state + co.B_delta() * tr.delta_rad + F)
     scale = np.abs(np.linalg.solve(co.M(U88), F)).max()
@@ -211,10 +216,10 @@ def test_trimmed_offtracking_equals_a_long_exact_run_with_the_trim_steer_held(na
     v = _vehicle(name)
     co = system_coefficients(v)
     F = load_vector(v, one_percent_rule(v, [v.unit_names[-1]]))
-    tr = measures.trim(v, U88, F)
+    tr = trim(v, U88, F)
     t = np.linspace(0, 120, 241)
     r = simulate(v, t, U88, F + co.B_delta() * tr.delta_rad)
-    (uq, xq), (up, xp) = measures.reference_points(v)
+    (uq, xq), (up, xp) = reference_points(v)
     YQ = global_lateral(v, uq, xq, r["psi1"], r["Y1"], r.theta)
     YP = global_lateral(v, up, xp, r["psi1"], r["Y1"], r.theta)
     Vy = (YQ[-1] - YQ[-2]) / (t[-1] - t[-2])                   # every point drifts at the same rate
@@ -243,10 +248,10 @@ def test_lcv_measures_prints_every_spec_key(source):
     assert p.returncode == 0, p.stderr
     doc = json.loads(p.stdout)
     assert set(doc) == SPEC_KEYS | {"trim"} and set(doc["trim"]) == {"delta_rad", "offtracking_m"}
-    ref = measures.measure_set(v, U88, load_units=load.split(",")).to_dict()
+    ref = measure_set(v, U88, load_units=load.split(",")).to_dict()
     assert doc == json.loads(json.dumps(ref))
     assert len(doc["ay_gain_per_unit"]) == v.n_units
-    gains = np.abs(measures.steer_to_acceleration(v, U88, 0.4))
+    gains = np.abs(steer_to_acceleration(v, U88, 0.4))
     np.testing.assert_allclose(doc["ay_gain_per_unit"], gains, rtol=1e-12)
     assert doc["ra_frequency"] == pytest.approx(gains[-1] / gains[0], rel=1e-12)
 
@@ -259,13 +264,13 @@ def test_lcv_measures_without_load_has_no_trim():
 
 
 def test_conicity_sensitivity_is_linear_and_ranked(aucnat):
-    rows = measures.conicity_sensitivity(aucnat, U88)
+    rows = conicity_sensitivity(aucnat, U88)
     assert len(rows) == len(aucnat.axles)
     keys = [r.largest_m for r in rows]
     assert keys == sorted(keys, reverse=True)
     co = system_coefficients(aucnat)
     col = aucnat.axle_names.index(rows[0].axle)
-    tr = measures.trim(aucnat, U88, co.B_P[:, col] * 2500.0)      # 2.5 kN: 2.5x the per-kN number
+    tr = trim(aucnat, U88, co.B_P[:, col] * 2500.0)      # 2.5 kN: 2.5x the per-kN number
     assert tr.offtracking_m == pytest.approx(2.5 * rows[0].offtracking_per_P_m_per_kN, rel=1e-10)
 
 
@@ -275,7 +280,7 @@ def test_measure_sets_from_threads_equal_the_serial_ones():
     from concurrent.futures import ThreadPoolExecutor
     v = load_preset("tractor_semitrailer")
     speeds = [12.0 + 1.5 * k for k in range(12)]             # more speeds than the maps kept
-    serial = [measures.measure_set(v, u).to_dict() for u in speeds]
+    serial = [measure_set(v, u).to_dict() for u in speeds]
     with ThreadPoolExecutor(4) as pool:
-        threaded = list(pool.map(lambda u: measures.measure_set(v, u).to_dict(), speeds * 2))
+        threaded = list(pool.map(lambda u: measure_set(v, u).to_dict(), speeds * 2))
     assert threaded == serial * 2

@@ -17,8 +17,9 @@ import numpy as np
 import pytest
 
 from lcvreport import PRESETS, load_preset, load_vehicle
-from lcvreport.analysis import field_measures as fm
-from lcvreport.analysis.low_speed_turn import low_speed_turn
+from lcvreport.measures.offtracking import HSSO_RADIUS_M, steady_turn
+from lcvreport.measures.yaw_damping import ratio_damping, yaw_damping_coefficient
+from lcvreport.measures.low_speed import low_speed_turn
 from lcvreport.model.vehicle import Axle, Unit, Vehicle
 
 from conftest import EXAMPLES, TOOLS
@@ -60,11 +61,11 @@ def test_hsso_at_walking_pace_is_the_exact_geometry_of_a_chain_on_a_circle(L, k)
     12: ~1e-3 of HSSO at 393 m; 4-5e-4 measured).  The first version's HSSO (every axis at
     u/Omega) read ~0 for every trailer."""
     v = _single_axle_chain(L, k + [0.0])
-    t = fm.steady_turn(v, 0.1)
+    t = steady_turn(v, 0.1)
     R_s = t.path_radius_m["s"]
     exact = math.sqrt(R_s ** 2 - sum(x * x for x in L) + sum(x * x for x in k)) - R_s
     assert t.hsso_m == pytest.approx(exact, rel=1e-3)
-    first_order = -(sum(x * x for x in L) - sum(x * x for x in k)) / (2 * fm.HSSO_RADIUS_M)
+    first_order = -(sum(x * x for x in L) - sum(x * x for x in k)) / (2 * HSSO_RADIUS_M)
     assert t.hsso_m == pytest.approx(first_order, rel=1e-3)
     assert t.hsso_m < -0.05                       # the trailers' geometric offtracking is there
 
@@ -76,10 +77,10 @@ def test_hsso_equals_an_independent_steady_state_and_geometry(name, v, kph):
     its sideslips v_i/u, and the chain placed on the circle in world coordinates by brentq (not the
     closed-form root): HSSO and every axle's path radius to 1e-9 relative."""
     u = kph / 3.6
-    t = fm.steady_turn(v, u)
-    vel, delta = steady_turn_newton_euler(v, u, u / fm.HSSO_RADIUS_M)
+    t = steady_turn(v, u)
+    vel, delta = steady_turn_newton_euler(v, u, u / HSSO_RADIUS_M)
     assert delta == pytest.approx(t.delta_rad, rel=1e-9)
-    radius = chain_on_circle_by_root_finding(v, vel / u, fm.HSSO_RADIUS_M)
+    radius = chain_on_circle_by_root_finding(v, vel / u, HSSO_RADIUS_M)
     for i, a in zip(v.axle_units, v.axles):
         assert radius(i, a.x_m) == pytest.approx(t.path_radius_m[a.name], rel=1e-12)
     steered = max(v.steered_axles, key=lambda a: a.x_m)
@@ -93,13 +94,13 @@ def test_hsso_of_the_tractor_semitrailer_is_its_textbook_low_speed_value():
     x0_1, k_1 = x0_1 - fifth wheel, L_2 = kingpin - x0_2, e_2 = rear axle - x0_2."""
     v = load_preset("tractor_semitrailer")
     u = 0.1
-    t = fm.steady_turn(v, u)
-    vel, _ = steady_turn_newton_euler(v, u, u / fm.HSSO_RADIUS_M)
-    x0 = -vel / u * fm.HSSO_RADIUS_M
+    t = steady_turn(v, u)
+    vel, _ = steady_turn_newton_euler(v, u, u / HSSO_RADIUS_M)
+    x0 = -vel / u * HSSO_RADIUS_M
     steer = max(v.steered_axles, key=lambda a: a.x_m).x_m
     L1, k1 = steer - x0[0], x0[0] - v.units[0].rear_coupling_m
     L2, e2 = v.units[1].front_coupling_m - x0[1], v.units[1].rearmost_axle.x_m - x0[1]
-    closed = -(L1 ** 2 + L2 ** 2 - k1 ** 2 - e2 ** 2) / (2 * fm.HSSO_RADIUS_M)
+    closed = -(L1 ** 2 + L2 ** 2 - k1 ** 2 - e2 ** 2) / (2 * HSSO_RADIUS_M)
     assert t.hsso_m == pytest.approx(closed, rel=1e-3)
 
 
@@ -107,7 +108,7 @@ def test_the_report_turn_table_is_the_hsso_geometry():
     from lcvreport.report.assessment import Assessment
     a = Assessment.load(vehicle_file=str(EXAMPLES / "b_double.toml"), speed_kph=88.0, fast=True)
     rows = {r["axle"]: r for r in a.turn_rows()}
-    t = fm.steady_turn(a.vehicle, 88 / 3.6)
+    t = steady_turn(a.vehicle, 88 / 3.6)
     for name, r in t.path_radius_m.items():
         assert rows[name]["path_radius_m"] == pytest.approx(r, rel=1e-15)
 
@@ -122,7 +123,7 @@ def _ydc_by_the_corrected_spec(v, u):
     the free decay from the largest, those >= 5 % of it, the first six, the mean zeta of
     consecutive pairs, the smallest over the joints."""
     from lcvreport.analysis.exact import response
-    from lcvreport.analysis.manoeuvres import pulse
+    from lcvreport.manoeuvres.steer import pulse
     r = response(v, u, pulse(0.01, 0.5), 40.5, 1e-3)
     t = r.time
     zetas = []
@@ -151,7 +152,7 @@ def _ydc_by_the_corrected_spec(v, u):
 @pytest.mark.parametrize("kph", [60.0, 80.0, 100.0])
 def test_ydc_equals_an_independent_implementation_of_the_corrected_spec(name, v, kph):
     u = kph / 3.6
-    got = fm.yaw_damping_coefficient(v, u)
+    got = yaw_damping_coefficient(v, u)
     ref = _ydc_by_the_corrected_spec(v, u)
     if ref is None:
         assert got.value is None and got.lower_bound == pytest.approx(ZETA_5, rel=1e-15)
@@ -166,7 +167,7 @@ def test_a_small_forced_extremum_before_the_main_peak_is_not_the_free_decay():
     t = (np.arange(8) * np.pi - np.angle(lam)) / lam.imag
     decay = np.exp(lam.real * t) * np.sin(lam.imag * t)
     values = np.r_[0.02 * decay[0], 0.0, decay]            # the forced wiggle, then the free decay
-    zeta, P = fm.ratio_damping(values)
+    zeta, P = ratio_damping(values)
     assert zeta == pytest.approx(-lam.real / abs(lam), rel=1e-12)
     from lcvreport.analysis.batch import ratio_damping_groups
     z, _g, _s = ratio_damping_groups(np.zeros(values.size, int), np.zeros(values.size, int), values)
@@ -178,14 +179,14 @@ def test_ydc_over_speed_follows_the_modal_damping_of_the_a_double():
     ratio falls, never jumping to a fifth of its neighbours (the first version read 0.04 at 60 km/h
     on a 30 m A-double decaying x85 per half cycle)."""
     v = load_vehicle(EXAMPLES / "western_double.toml")
-    ydc = [fm.yaw_damping_coefficient(v, k / 3.6).value for k in (60, 70, 80, 90, 100)]
+    ydc = [yaw_damping_coefficient(v, k / 3.6).value for k in (60, 70, 80, 90, 100)]
     assert all(x is not None and 0.2 < x < 0.6 for x in ydc), ydc
     assert all(b < 1.25 * a for a, b in zip(ydc, ydc[1:])), ydc
 
 
 def test_a_heavily_damped_vehicle_has_a_null_ydc_with_its_lower_bound_and_criteria_judge_it(tmp_path):
     v = load_vehicle(EXAMPLES / "b_double.toml")
-    y = fm.yaw_damping_coefficient(v, 60 / 3.6)
+    y = yaw_damping_coefficient(v, 60 / 3.6)
     assert y.value is None and y.lower_bound == pytest.approx(ZETA_5, rel=1e-15) and "heavily damped" in y.why
     assert round(ZETA_5, 4) == 0.6901
     for limit, verdict in ((0.5, "pass"), (0.6901, "pass"), (0.8, "not computed")):
@@ -202,7 +203,7 @@ def test_a_heavily_damped_vehicle_has_a_null_ydc_with_its_lower_bound_and_criter
 def test_a_single_unit_has_no_joint_and_no_bound():
     v = Vehicle("truck", (Unit("truck", 12000.0, 6.0e4, (Axle("f", 2.5, 2, 2e5, 0.0, 0.0, 0.0, steered=True),
                                                         Axle("r", -3.0, 8, 1.5e5, 0.0, 0.0, 0.0))),))
-    y = fm.yaw_damping_coefficient(v, 24.0)
+    y = yaw_damping_coefficient(v, 24.0)
     assert y.value is None and y.lower_bound is None and y.why.startswith("no joint")
 
 
@@ -335,7 +336,7 @@ def test_tight_turns_a_vehicle_can_make_give_numbers():
 
 
 def test_the_turn_angle_has_one_range_for_the_api_and_the_cli():
-    from lcvreport.analysis.low_speed_turn import TurnError
+    from lcvreport.model.body import TurnError
     v = load_preset("tractor_semitrailer")
     assert low_speed_turn(v, angle_deg=3600.0).lssp_m > 0
     for bad in (0.0, 3600.5, float("nan")):
@@ -348,7 +349,7 @@ def test_the_turn_angle_has_one_range_for_the_api_and_the_cli():
 
 # ---------------------------------------------------------------------------- --help, criteria, reasons
 def _commands():
-    from lcvreport.cli import build_parser
+    from lcvreport.cli.main import build_parser
     import argparse
     out = []
 
@@ -370,7 +371,7 @@ def test_every_command_and_subcommand_has_a_help(cmd):
 
 def test_every_scalar_the_json_prints_can_be_judged(tmp_path):
     """lssp_m and the other low-speed measures, the trim (one spelling: the JSON's), the bound."""
-    from lcvreport.analysis.registry import CRITERIA_KEYS
+    from lcvreport.measures.registry import CRITERIA_KEYS
     lines = ["[limits]"] + [f'"{k}" = {{ max = 1e9, source = "all" }}' for k in CRITERIA_KEYS]
     crit = tmp_path / "c.toml"
     crit.write_text("\n".join(lines) + "\n")
@@ -406,7 +407,7 @@ def test_a_study_judges_the_trim_the_criteria_file_names(tmp_path):
     from lcvreport.study.spec import study_from_dict
     from lcvreport.study.results import read_study
     from lcvreport.study.summary import pass_rates
-    from lcvreport.analysis.criteria import load_criteria
+    from lcvreport.measures.criteria import load_criteria
     out = tmp_path / "s"
     run_study(study_from_dict({"vehicle": "aucnat", "speed_kph": 88.0, "measures": ["trim.offtracking_m", "hsso_m"],
                                "factors": {"load_units": {"values": [["trailer3"], ["trailer2", "trailer3"]]}}}), out)
@@ -431,7 +432,7 @@ def test_model_exchange_at_fmusims_default_tolerance_is_within_1_percent(tmp_pat
     lateral acceleration's and state's peak (with nominals of 1 it read ay3 23 % off; 1.4 % on
     the western double)."""
     from lcvreport.analysis.exact import response
-    from lcvreport.analysis.manoeuvres import step
+    from lcvreport.manoeuvres.steer import step
     from fmu_support import host_env, interface_of
     for fmu, vehicle in [(native_fmu, load_preset("aucnat"))] + \
             [(all_example_fmus[n]["native"], load_vehicle(EXAMPLES / f"{n}.toml")) for n in ("western_double",
@@ -488,7 +489,7 @@ def test_the_fmu_gives_hsto_through_every_axles_lateral_position(all_example_fmu
     axle's centre (the FMU steps exactly for inputs held over the step)."""
     from fmpy import simulate_fmu
     from lcvreport.analysis.exact import response
-    from lcvreport.analysis.manoeuvres import step
+    from lcvreport.manoeuvres.steer import step
     v = load_vehicle(EXAMPLES / "b_double.toml")
     r = response(v, 22.352, step(0.01), 5.0, 0.01)
     res = simulate_fmu(str(all_example_fmus["b_double"]["native"]), stop_time=5.0, output_interval=0.01,
@@ -506,7 +507,7 @@ def _anchors(path):
 
 
 def test_every_measure_is_defined_in_docs():
-    from lcvreport.analysis.registry import MEASURES
+    from lcvreport.measures.registry import MEASURES
     anchors = _anchors(ROOT / "docs" / "measures.md")
     missing = {k: m.doc for k, m in MEASURES.items() if m.doc not in anchors}
     assert not missing, missing

@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 
 from lcvreport import eigenvalues, modes, steady_state
 from lcvreport.analysis.modes import sort_eigenvalues
-from lcvreport.model.builder import system_coefficients, system_matrices
-from lcvreport.model.loads import ResidualLoads, load_vector
+from lcvreport.model.yaw_plane.equations import system_coefficients, system_matrices
+from lcvreport.model.yaw_plane.loads import ResidualLoads, load_vector
 from lcvreport.model.presets import PRESETS, load_preset
 from lcvreport.model.vehicle import Axle, Unit, Vehicle
 from lcvreport.model.vehicle_file import load_vehicle

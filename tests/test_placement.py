@@ -15,10 +15,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from lcvreport import load_preset
-from lcvreport.analysis.measures import trim
-from lcvreport.analysis.placement import GAP_M, TIE_M, place_tires
-from lcvreport.analysis.tracking import TrackingError, axle_residuals
-from lcvreport.model.builder import system_coefficients
+from lcvreport.analysis.steady import trim
+from lcvreport.tracking.placement import GAP_M, TIE_M, place_tires
+from lcvreport.tracking.tires import TrackingError, axle_residuals
+from lcvreport.model.yaw_plane.equations import system_coefficients
 
 U88 = 88 / 3.6
 VEHICLES = {name: load_preset(name) for name in ("tractor_semitrailer", "aucnat")}

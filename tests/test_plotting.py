@@ -11,9 +11,14 @@ import pytest  # noqa: E402
 from matplotlib.text import Text  # noqa: E402
 
 from lcvreport import load_preset, load_vehicle, modes  # noqa: E402
-from lcvreport.analysis import measures  # noqa: E402
-from lcvreport.report import plotting  # noqa: E402
-from lcvreport.report.reporting import PORTRAIT_LINE_PT, setup  # noqa: E402
+from lcvreport.measures.amplification import single_sine
+from lcvreport.measures.stability import speed_sweep
+from lcvreport.plotting.charts import fig_bars
+from lcvreport.plotting.frequency import fig_damping_over_speed, fig_frequency, fig_root_locus
+from lcvreport.thesis.figures import fig_free_body, fig_load_configuration
+from lcvreport.plotting.vehicle import fig_mode_shape, fig_vehicle
+from lcvreport.plotting.time import fig_time
+from lcvreport.report.tables import PORTRAIT_LINE_PT, setup  # noqa: E402
 
 from conftest import EXAMPLES  # noqa: E402
 
@@ -24,20 +29,20 @@ def _figures():
     setup(None)
     aucnat, semi = load_preset("aucnat"), load_preset("tractor_semitrailer")
     western = load_vehicle(EXAMPLES / "western_double.toml")
-    sweep = measures.speed_sweep(aucnat, np.linspace(10, 130, 13))
+    sweep = speed_sweep(aucnat, np.linspace(10, 130, 13))
     f = np.linspace(0.1, 2, 20)
     return {
-        "free body, triple (Figure 4-1)": plotting.fig_free_body(aucnat, "x"),
-        "free body, semi (Figure 3-1)": plotting.fig_free_body(semi, "x"),
-        "vehicle drawing": plotting.fig_vehicle(western, "x"),
-        "mode shape": plotting.fig_mode_shape(aucnat, modes(aucnat, U), 4, "x"),
-        "load configuration": plotting.fig_load_configuration(aucnat, "balanced", "x"),
-        "root locus": plotting.fig_root_locus(sweep.speeds_kph, sweep.eigenvalues, "x"),
-        "damping over speed": plotting.fig_damping_over_speed(sweep.speeds_kph, sweep.least_damping_ratio,
+        "free body, triple (Figure 4-1)": fig_free_body(aucnat, "x"),
+        "free body, semi (Figure 3-1)": fig_free_body(semi, "x"),
+        "vehicle drawing": fig_vehicle(western, "x"),
+        "mode shape": fig_mode_shape(aucnat, modes(aucnat, U), 4, "x"),
+        "load configuration": fig_load_configuration(aucnat, "balanced", "x"),
+        "root locus": fig_root_locus(sweep.speeds_kph, sweep.eigenvalues, "x"),
+        "damping over speed": fig_damping_over_speed(sweep.speeds_kph, sweep.least_damping_ratio,
                                                               sweep.max_real, "x", None, 88.0),
-        "RA curve": plotting.fig_frequency(f, [("RA", np.ones_like(f))], "rearward amplification [-]", "x"),
-        "single sine": measures.single_sine(aucnat, U).plot(),
-        "bars": plotting.fig_bars(["a", "b"], [("g", np.array([1.0, 2.0]))], "y [m]", "x"),
+        "RA curve": fig_frequency(f, [("RA", np.ones_like(f))], "rearward amplification [-]", "x"),
+        "single sine": single_sine(aucnat, U).plot(),
+        "bars": fig_bars(["a", "b"], [("g", np.array([1.0, 2.0]))], "y [m]", "x"),
     }
 
 
@@ -70,14 +75,14 @@ def _text_boxes(fig):
 
 
 CROWDED = {
-    "time, 16 series with peaks (Figure 5-2)": lambda: plotting.fig_time(
+    "time, 16 series with peaks (Figure 5-2)": lambda: fig_time(
         [(f"run {k}" + (" (as published)" if k >= 8 else ""), np.linspace(0, 3, 61),
           np.sin(np.linspace(0, 3, 61) + 0.01 * k) * (1 + 0.001 * k), {}) for k in range(16)],
         "y6 [in]", "x", xlim=(0, 3), annotate_peaks=True),
-    "time, close horizontal lines (Figure 5-3)": lambda: plotting.fig_time(
+    "time, close horizontal lines (Figure 5-3)": lambda: fig_time(
         [("a", np.linspace(5, 10, 11), np.full(11, 0.46), {})], "y6 [in]", "x",
         hlines=[(f"run {k}: {v:.3f}", v) for k, v in enumerate([0.341, 0.461, 0.466, 0.927, 0.969, 1.268, 1.436])]),
-    "bars, 22 categories across (Figure 5-20)": lambda: plotting.fig_bars(
+    "bars, 22 categories across (Figure 5-20)": lambda: fig_bars(
         [f"study {k // 5}: case {k}" for k in range(22)],
         [("corrected", np.linspace(-60, 60, 22)), ("thesis loads", np.linspace(50, -90, 22))],
         "change [%]", "x", height=6.4, horizontal=True),
@@ -99,7 +104,8 @@ def test_plan_view_draws_every_axle_above_every_body_and_measures_from_the_cab_f
     an overall length that left out the cab (CG to steer axle)."""
     from matplotlib.patches import Polygon
     from lcvreport.model.presets import load_preset
-    from lcvreport.report.plotting import FRONT_OVERHANG_M, fig_vehicle, unit_kind
+    from lcvreport.model.body import FRONT_OVERHANG_M, unit_kind
+    from lcvreport.plotting.vehicle import fig_vehicle
     v = load_preset("aucnat")
     fig = fig_vehicle(v, "aucnat")
     ax = fig.axes[0]
@@ -109,7 +115,7 @@ def test_plan_view_draws_every_axle_above_every_body_and_measures_from_the_cab_f
     assert min(t.get_zorder() for t in tires) > max(b.get_zorder() for b in bodies)
     assert [unit_kind(v, k) for k in range(6)] == ["tractor", "trailer", "dolly", "trailer", "dolly", "trailer"]
     # the bodies of the vehicle file (issue 19): the overall length is theirs
-    from lcvreport.analysis.low_speed_turn import overall_length_m
+    from lcvreport.model.body import overall_length_m
     front_x = max(p.get_xy()[:, 0].max() for p in bodies)
     rear_x = min(p.get_xy()[:, 0].min() for p in bodies)
     assert front_x - rear_x == pytest.approx(overall_length_m(v), rel=1e-12)

@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lcvreport.analysis.geometry import rear_offsets
-from lcvreport.model.builder import system_matrices
-from lcvreport.model.loads import load_vector, one_percent_rule
+from lcvreport.model.yaw_plane.outputs import rear_offsets
+from lcvreport.model.yaw_plane.equations import system_matrices
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
 from lcvreport.model.presets import load_preset
 from lcvreport.thesis import audit, studies
 from lcvreport.thesis.tables import published

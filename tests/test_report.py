@@ -26,7 +26,7 @@ import pytest
 from lcvreport.fmu.interface import vehicle_interface
 from lcvreport.model.presets import PRESETS
 from lcvreport.model.vehicle_file import load_vehicle
-from lcvreport.report.build import NOTEBOOKS, SPECS, ReportError, execute, overfull_boxes
+from lcvreport.report.notebooks import NOTEBOOKS, SPECS, ReportError, execute, overfull_boxes
 
 from conftest import EXAMPLES, ROOT
 
@@ -166,7 +166,7 @@ def test_failing_notebook_fails_the_build_and_leaves_no_stale_report(tmp_path):
 # ---------------------------------------------------------------------------- parameters
 def _accepted(stem: str) -> tuple[str, ...]:
     """The presets notebook ``stem`` serves, asked of its parameter check."""
-    from lcvreport.report.build import check_notebook_parameters
+    from lcvreport.report.notebooks import check_notebook_parameters
     ok = []
     for p in PRESETS:
         try:
@@ -337,10 +337,11 @@ def test_assessment_tracking_chapter(assessment):
     """With --tires and --tracking-stats (aucnat): the population's exact moments and the
     placement plan are the package's (SPEC 13), the CSV beside each; without: a note."""
     from lcvreport import load_preset
-    from lcvreport.analysis.measures import trim
-    from lcvreport.analysis.placement import place_tires
-    from lcvreport.analysis.tracking import axle_residuals, parse_stats_spec, read_mounted_tires, stats_from_spec
-    from lcvreport.model.loads import ResidualSources
+    from lcvreport.analysis.steady import trim
+    from lcvreport.tracking.placement import place_tires
+    from lcvreport.tracking.tires import axle_residuals, read_mounted_tires
+    from lcvreport.tracking.statistics import parse_stats_spec, stats_from_spec
+    from lcvreport.model.yaw_plane.loads import ResidualSources
     name, out, _p = assessment
     html = (out / "index.html").read_text(encoding="utf-8")
     assert "Straight-line tracking" in html

@@ -12,7 +12,8 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from lcvreport.analysis.driver import DEFAULT, closed_loop
+from lcvreport.manoeuvres.drivers import DEFAULT
+from lcvreport.analysis.closed_loop import closed_loop
 from lcvreport.model.vehicle_file import load_vehicle
 from lcvreport.units import kph_to_mps
 

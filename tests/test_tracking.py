@@ -13,10 +13,10 @@ import pytest
 from scipy.stats import norm
 
 from lcvreport import load_preset, load_vehicle
-from lcvreport.analysis.measures import trim
-from lcvreport.analysis.tracking import (TrackingError, axle_residuals, parse_distribution, serial_sign, slots_of,
-                                         tracking_stats)
-from lcvreport.model.builder import system_coefficients
+from lcvreport.analysis.steady import trim
+from lcvreport.tracking.tires import TrackingError, axle_residuals, serial_sign, slots_of
+from lcvreport.tracking.statistics import parse_distribution, tracking_stats
+from lcvreport.model.yaw_plane.equations import system_coefficients
 
 from conftest import EXAMPLES
 
@@ -87,7 +87,7 @@ def test_exact_mean_and_sd_equal_an_independent_computation_and_a_monte_carlo(mo
     s = tracking_stats(v, U88, c, p, mounting, cm, pm, draws=1_000_000, seed=7)
     slots = [(a.name, slot) for i, a in zip(v.axle_units, v.axles) if i >= 1 for slot in
              slots_of(a.tires)]
-    from lcvreport.analysis.tracking import _side
+    from lcvreport.tracking.tires import _side
     Es = [0.0 if mounting == "random" else _side(slot, v.axles[v.axle_names.index(ax)].tires) for ax, slot in slots]
     mean, sd = _independent_moments(v, [ax for ax, _ in slots], c, p, cm, pm, Es)
     assert s.offtracking_mean_m == pytest.approx(mean, rel=1e-9)

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from lcvreport import load_preset
-from lcvreport.analysis.tracking import Distribution, sensitivities, tire_slots, tracking_stats
+from lcvreport.tracking.statistics import Distribution, tracking_stats
+from lcvreport.tracking.tires import sensitivities, tire_slots
 from lcvreport.thesis import tracking_questions as tq
 from lcvreport.units import mph_to_mps
 

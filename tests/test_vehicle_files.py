@@ -11,12 +11,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 
-from lcvreport.model.builder import system_coefficients
-from lcvreport.model.loads import load_vector, one_percent_rule
+from lcvreport.model.yaw_plane.equations import system_coefficients
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
 from lcvreport.model.presets import PRESETS, load_preset, preset_path
 from lcvreport.model.vehicle import Axle, Unit, Vehicle, VehicleError
-from lcvreport.model.vehicle_file import (VehicleFileError, dumps_vehicle, load_vehicle, loads_vehicle,
-                                          vehicle_from_dict)
+from lcvreport.model.vehicle_file import VehicleFileError, dumps_vehicle, load_vehicle, loads_vehicle, vehicle_from_dict
 from lcvreport.thesis.vehicles import preset_file_text
 from lcvreport.units import THESIS
 

@@ -159,7 +159,7 @@ def test_native_fmu_sources_rebuild_the_same_binary_behaviour(c_host, western_fm
     zipfile.ZipFile(fmu).extractall(rebuilt)
     so = rebuilt / "binaries" / "linux64" / f"{fmu.stem}.so"
     so.unlink()
-    from lcvreport.fmu.build import fmi_header_dir
+    from lcvreport.fmu.c_sources import fmi_header_dir
     subprocess.run(["gcc", "-std=c99", "-O2", "-shared", "-fPIC", "-I", str(src), "-I", str(fmi_header_dir()),
                     "-o", str(so),
                     *sorted(str(c) for c in src.glob("*.c")), "-lm"], check=True, capture_output=True)

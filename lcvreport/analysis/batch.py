@@ -31,8 +31,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..model.builder import system_coefficients
 from ..model.vehicle import Vehicle
+from ..model.yaw_plane.equations import system_coefficients
 from ..ranges import RANGES
 from ..util.numerics import solve_scaled
 
@@ -85,7 +85,7 @@ def _nominal(vehicle: Vehicle, name: str) -> float:
 
 
 def ratio_damping_groups(group: np.ndarray, signal: np.ndarray, values: np.ndarray):
-    """:func:`lcvreport.analysis.field_measures.ratio_damping` of many signals at once: ``values``
+    """:func:`lcvreport.measures.yaw_damping.ratio_damping` of many signals at once: ``values``
     holds each signal's extrema in time order, the signals one after the other, labelled by
     ``(group, signal)``.  Returns (zeta, group, signal) of every signal with two kept amplitudes
     or more (the same arithmetic in the same order: equal to the one-signal function to a few ulp,
@@ -96,11 +96,11 @@ def ratio_damping_groups(group: np.ndarray, signal: np.ndarray, values: np.ndarr
     >>> import numpy as np
     >>> A = np.exp(-0.3 * np.pi / 2 * np.arange(8)) * (-1.0) ** np.arange(8)
     >>> z, g, s = ratio_damping_groups(np.zeros(8, int), np.zeros(8, int), A)
-    >>> from lcvreport.analysis.field_measures import ratio_damping
+    >>> from lcvreport.measures.yaw_damping import ratio_damping
     >>> bool(abs(z[0] - ratio_damping(A)[0]) <= 1e-15)
     True
     """
-    from .field_measures import YDC_MAX_AMPLITUDES, YDC_MIN_FRACTION
+    from ..measures.yaw_damping import YDC_MAX_AMPLITUDES, YDC_MIN_FRACTION
     group, signal, values = np.asarray(group), np.asarray(signal), np.asarray(values, dtype=float)
     empty = (np.zeros(0), np.zeros(0, int), np.zeros(0, int))
     if values.size < 3:
@@ -201,7 +201,7 @@ class VariantBatch:
 
     def least_damping(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(least damping ratio [-], its damped frequency [Hz]) of every variant over the oscillatory
-        modes, as :func:`lcvreport.analysis.measures.least_damping` (NaN where none oscillates)."""
+        modes, as :func:`lcvreport.measures.stability.least_damping` (NaN where none oscillates)."""
         lam = self.eigenvalues(speed_mps, tire_scale)
         osc = lam.imag > 1e-12 * np.maximum(np.abs(lam).max(axis=-1, keepdims=True), 1.0)
         zeta = np.where(osc, -lam.real / np.where(np.abs(lam) > 0, np.abs(lam), 1.0), np.inf)
@@ -219,7 +219,7 @@ class VariantBatch:
     def steer_to_acceleration(self, speed_mps: float, f_hz: float, tire_scale: float = 1.0) -> np.ndarray:
         """G_i(j 2 pi f): gain from the steer angle to every unit's CG lateral acceleration
         [m/s^2 per rad] of every variant, shape (B, N), as
-        :func:`lcvreport.analysis.measures.steer_to_acceleration` (the velocity and yaw-rate
+        :func:`lcvreport.analysis.frequency.steer_to_acceleration` (the velocity and yaw-rate
         maps depend on the geometry only, which the batch does not vary)."""
         co = system_coefficients(self.vehicle)
         c = self.coefficients
@@ -238,11 +238,11 @@ class VariantBatch:
 
     def trim(self, speed_mps: float, F, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(trim steer [rad], trimmed offtracking [m]) of every variant under the generalized
-        force ``F`` (SI; shape (2N,) for all or (B, 2N)), as :func:`lcvreport.analysis.measures.trim`.
+        force ``F`` (SI; shape (2N,) for all or (B, 2N)), as :func:`lcvreport.analysis.steady.trim`.
         F is taken as given: residual P and T map to it through the geometry alone, but a
         crossfall's m g depends on the masses the batch varies -- build its F per variant."""
-        from .geometry import point_lateral_map, point_longitudinal
-        from .measures import reference_points
+        from ..model.yaw_plane.outputs import point_lateral_map, point_longitudinal
+        from .steady import reference_points
         u = float(speed_mps)
         x, delta = self._steady(u, F, 0.0, tire_scale)
         v = self.vehicle
@@ -336,13 +336,13 @@ class VariantBatch:
 
     def _ra_peak(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(max RA(f) over 0.1-2 Hz [-], where [Hz]) of every variant: the 0.005 Hz scan of
-        :func:`lcvreport.analysis.field_measures.ra_peak` (on the variants' modes, :meth:`_ra_scan`),
+        :func:`lcvreport.measures.amplification.ra_peak` (on the variants' modes, :meth:`_ra_scan`),
         then the zero of the exact slope d ln RA / d omega in each variant's best bracket (the
         Illinois variant of regula falsi, to 1e-13 Hz; the one-variant version uses Brent's root
         finder on the same slope), a golden-section search on RA's values where the slope does not
         change sign across the bracket.  Each variant's search stops on its own, so its result does
         not depend on the other variants of the batch."""
-        from .field_measures import RA_BAND_HZ
+        from ..measures.amplification import RA_BAND_HZ
         lo, hi = RA_BAND_HZ
         f = np.linspace(lo, hi, 381)
         values = self._ra_scan(speed_mps, f, tire_scale)
@@ -530,7 +530,7 @@ class VariantBatch:
         derivative located on its Hermite interpolant, valued by the quintic one (as
         :meth:`~lcvreport.analysis.exact.ManoeuvreResponse.extrema`).  Flat arrays (variant,
         signal, time [s], value) and the signals' values at the last sample (B, K)."""
-        from .exact import _hermite_roots, _quintic
+        from .extrema import _hermite_roots, _quintic
         C1 = C @ Mz
         C2 = C1 @ Mz
         K = C.shape[1]
@@ -601,15 +601,15 @@ class VariantBatch:
 
     def lane_change(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(HSTO [m], the lane change's RA [-]) of every variant, as
-        :func:`lcvreport.analysis.field_measures.lane_change_measures` (the path-following lane
+        :func:`lcvreport.measures.offtracking.lane_change_measures` (the path-following lane
         change through each variant's inverse system): the last unit's rearmost axle's largest
         overshoot beyond the steered axle's final offset (0 if none), and max|a_N| / max|a_s|.
         NaN where the inverse system is unstable or does not exist, or the steer leaves
         [-1, 1] rad (measure_set's null)."""
+        from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
+        from ..measures.offtracking import DT_S, LANE_CHANGE, LANE_CHANGE_TAIL_S
+        from ..model.yaw_plane.outputs import point_lateral_map
         from .exact import steered_point
-        from .field_measures import DT_S, G_MPS2, LANE_CHANGE, LANE_CHANGE_TAIL_S
-        from .geometry import point_lateral_map
-        from .manoeuvres import lane_change, lane_change_offset_m
         v = self.vehicle
         B, nu, n = self.size, v.n_units, v.n_states
         accel_g, f_hz = LANE_CHANGE
@@ -678,11 +678,11 @@ class VariantBatch:
 
     def yaw_damping(self, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
         """The yaw damping coefficient [-] of every variant
-        (:func:`lcvreport.analysis.field_measures.yaw_damping_coefficient`: the pulse, each joint's
+        (:func:`lcvreport.measures.yaw_damping.yaw_damping_coefficient`: the pulse, each joint's
         extrema from its end to 40 s after on the continuous response, the ratio method, the
         smallest over the joints); NaN where no joint has two amplitudes."""
-        from .field_measures import YDC_DT_S, YDC_PULSE, YDC_WINDOW_S
-        from .manoeuvres import pulse
+        from ..manoeuvres.steer import pulse
+        from ..measures.yaw_damping import YDC_DT_S, YDC_PULSE, YDC_WINDOW_S
         v = self.vehicle
         B = self.size
         out = np.full(B, np.nan)
@@ -716,11 +716,11 @@ class VariantBatch:
 
     def single_sine(self, speed_mps: float, f_hz: float | None = None, tire_scale: float = 1.0) -> np.ndarray:
         """RA of the single sine [-] of every variant: max|a_N| / max|a_1| on the continuous exact
-        response (:func:`lcvreport.analysis.measures.single_sine`: ``delta0 sin(2 pi f t)`` for one
+        response (:func:`lcvreport.measures.amplification.single_sine`: ``delta0 sin(2 pi f t)`` for one
         period, then the tail)."""
-        from .manoeuvres import sine
-        from .measures import (RA_FREQUENCY_HZ, SINGLE_SINE_DELTA0_RAD, SINGLE_SINE_STEP_S, SINGLE_SINE_TAIL_S,
-                               _freq)
+        from ..manoeuvres.steer import sine
+        from ..measures.amplification import SINGLE_SINE_DELTA0_RAD, SINGLE_SINE_STEP_S, SINGLE_SINE_TAIL_S
+        from .frequency import RA_FREQUENCY_HZ, _freq
         f = float(_freq(RA_FREQUENCY_HZ if f_hz is None else f_hz))
         steer = sine(SINGLE_SINE_DELTA0_RAD, f)
         t_end = round((1.0 / f + SINGLE_SINE_TAIL_S) / SINGLE_SINE_STEP_S) * SINGLE_SINE_STEP_S
@@ -730,7 +730,7 @@ class VariantBatch:
 
     def _steady(self, u: float, F, r1: float, tire_scale: float) -> tuple[np.ndarray, np.ndarray]:
         """S x + b delta + F = 0 with x[1] = r1 for every variant, as
-        :func:`lcvreport.analysis.measures.steady_with_yaw_rate`: (x (B, 2N), delta (B,))."""
+        :func:`lcvreport.analysis.steady.steady_with_yaw_rate`: (x (B, 2N), delta (B,))."""
         c = self.coefficients
         n = c["M0"].shape[-1]
         B = self.size
@@ -747,8 +747,8 @@ class VariantBatch:
     def steady_turn(self, speed_mps: float, tire_scale: float = 1.0, radius_m: float | None = None
                     ) -> tuple[np.ndarray, np.ndarray]:
         """(hsso_m, steer [rad]) of every variant in the steady turn of
-        :func:`lcvreport.analysis.field_measures.steady_turn` (tractor yaw rate u/R)."""
-        from .field_measures import HSSO_RADIUS_M, chain_on_circle
+        :func:`lcvreport.measures.offtracking.steady_turn` (tractor yaw rate u/R)."""
+        from ..measures.offtracking import HSSO_RADIUS_M, chain_on_circle
         R = HSSO_RADIUS_M if radius_m is None else float(radius_m)
         u = float(speed_mps)
         omega = u / R
@@ -779,10 +779,10 @@ class VariantBatch:
     def _critical_speed(self, tire_scale: float = 1.0, u_min_mps: float | None = None,
                         u_max_kph: float | None = None) -> np.ndarray:
         """The critical speed [km/h] of every variant (NaN: stable up to ``u_max_kph``), by the
-        algorithm of :func:`lcvreport.analysis.measures.critical_speed` run on all variants at
+        algorithm of :func:`lcvreport.measures.stability.critical_speed` run on all variants at
         once: the coarse 4 km/h scan, the 1 km/h scan of each variant's own doubtful intervals,
         the bisection to 0.01 km/h, rounded to 0.1 km/h."""
-        from ..analysis.measures import CRITICAL_SPEED_MAX_KPH, U_MIN_DEFAULT_MPS
+        from ..measures.stability import CRITICAL_SPEED_MAX_KPH, U_MIN_DEFAULT_MPS
         from ..ranges import RANGES
         from ..units import mps_to_kph
         u_max_kph = CRITICAL_SPEED_MAX_KPH if u_max_kph is None else u_max_kph
@@ -843,10 +843,10 @@ class VariantBatch:
 
     def measure_group(self, name: str, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None,
                       F=None) -> tuple:
-        """The arrays of one group of :data:`lcvreport.analysis.registry.BATCHED` (``name``: the
+        """The arrays of one group of :data:`lcvreport.measures.registry.BATCHED` (``name``: the
         method), in the order of its keys.  ``F`` (B, 2N) is every variant's generalized force of
         its residual sources (the trim's; NaN rows: none)."""
-        from .measures import RA_FREQUENCY_HZ
+        from .frequency import RA_FREQUENCY_HZ
         f_hz = RA_FREQUENCY_HZ if f_hz is None else f_hz
         if name == "critical_speed":
             return (self.critical_speed(tire_scale),)
@@ -855,7 +855,7 @@ class VariantBatch:
         if name == "single_sine":
             return (self.single_sine(speed_mps, f_hz, tire_scale),)
         if name == "yaw_damping":
-            from .field_measures import YDC_HEAVY_ZETA
+            from ..measures.yaw_damping import YDC_HEAVY_ZETA
             zeta = self.yaw_damping(speed_mps, tire_scale)
             bound = np.where(np.isnan(zeta) & (self.vehicle.n_units > 1), YDC_HEAVY_ZETA, np.nan)
             return zeta, bound
@@ -875,10 +875,10 @@ class VariantBatch:
     def measures(self, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None, F=None):
         """The batched measures of every variant as columns (a dict of arrays of length B, ready
         for ``pandas.DataFrame``): a ``case_id``, one column per varied parameter and every
-        measure of :data:`lcvreport.analysis.registry.BATCHED` under its registry key (the trim's,
+        measure of :data:`lcvreport.measures.registry.BATCHED` under its registry key (the trim's,
         ``trim.delta_rad`` and ``trim.offtracking_m``, with ``F``); NaN where a measure is
         undefined (no oscillatory mode, stable to 200 km/h)."""
-        from .registry import BATCHED
+        from ..measures.registry import BATCHED
         table = {"case_id": np.arange(self.size)}
         table.update({name: np.asarray(arr, dtype=float) for name, arr in self.values.items()})
         table["speed_mps"] = np.full(self.size, float(speed_mps))

@@ -23,10 +23,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.builder import check_speed, system_coefficients
-from ..model.loads import ResidualLoads, load_vector
+from ..manoeuvres.drivers import DEFAULT, PreviewDriver
 from ..model.vehicle import Vehicle
-from .discretize import Discretizer
+from ..model.yaw_plane.equations import check_speed, system_coefficients
+from ..model.yaw_plane.loads import ResidualLoads, load_vector
+from .discretize import Discretizer, augmented_state_matrix
 from .response import TimeResponse
 
 
@@ -85,3 +86,52 @@ def steer_feedback(vehicle: Vehicle, speed_mps: float, gains: tuple[float, float
     response = TimeResponse(t, z, vehicle, np.full(t.size, float(speed_mps)), forces, float(tire_scale),
                             label="steer feedback")
     return SteerFeedback(response, delta)
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """Time histories of the closed loop (SI): time [s], states z = [x, psi1, Y1], steer [rad]."""
+
+    time_s: np.ndarray
+    states: np.ndarray
+    steer_rad: np.ndarray
+
+    @property
+    def Y1_m(self) -> np.ndarray:
+        return self.states[:, -1]
+
+    @property
+    def psi1_rad(self) -> np.ndarray:
+        return self.states[:, -2]
+
+
+def closed_loop(vehicle: Vehicle, speed_mps: float, driver: PreviewDriver = DEFAULT, t_end: float = 10.0,
+                dt: float = 0.01, tire_scale: float = 1.0, rtol: float = 1e-12, atol: float = 1e-14) -> ClosedLoop:
+    """The continuous closed loop of ``vehicle`` at ``speed_mps`` [m/s] and ``driver`` from rest,
+    sampled every ``dt`` [s] to ``t_end`` [s]: z' = A_aug z + G b_delta delta(t, z), integrated
+    by :func:`scipy.integrate.solve_ivp` (DOP853) segment by segment of the reference (its
+    second derivative jumps at the ramp's ends).
+
+    Returns
+    -------
+    ClosedLoop
+    """
+    from scipy.integrate import solve_ivp
+    co = system_coefficients(vehicle)
+    A, G = augmented_state_matrix(co, speed_mps, tire_scale)
+    b = G @ co.B_delta(tire_scale)
+    n = co.n_states
+
+    def f(t, z):
+        return A @ z + b * driver.steer_rad(t, z[n + 1], z[n])
+
+    t_eval = np.round(np.arange(0.0, t_end + 0.5 * dt, dt) / dt) * dt
+    breaks = sorted({0.0, t_end, *(x for x in (driver.start_s, driver.start_s + driver.duration_s) if 0 < x < t_end)})
+    z = np.zeros(n + 2)
+    out = np.empty((t_eval.size, n + 2))
+    for lo, hi in zip(breaks[:-1], breaks[1:]):
+        sel = (t_eval >= lo) & (t_eval <= hi)
+        sol = solve_ivp(f, (lo, hi), z, method="DOP853", rtol=rtol, atol=atol, t_eval=t_eval[sel], dense_output=True)
+        out[sel] = sol.y.T
+        z = sol.sol(hi)
+    return ClosedLoop(t_eval, out, driver.steer_rad(t_eval, out[:, n + 1], out[:, n]))

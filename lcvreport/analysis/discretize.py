@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model.builder import SystemCoefficients, system_coefficients
 from ..model.vehicle import Vehicle
+from ..model.yaw_plane.equations import SystemCoefficients, system_coefficients
 from ..util.cache import LRUCache
 
 #: names of the two states appended to the model state for global position

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.builder import check_speed, check_tire_scale, system_coefficients
 from ..model.vehicle import Vehicle
+from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
 from ..util.numerics import solve_scaled
 
 

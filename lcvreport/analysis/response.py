@@ -22,11 +22,11 @@ from typing import Iterator
 
 import numpy as np
 
-from ..model.builder import check_speed, check_tire_scale, system_coefficients
 from ..model.vehicle import Vehicle
+from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.outputs import rear_end_global, rear_offsets
 from ..ranges import RANGES, RangeError
 from .discretize import GLOBAL_STATES, Discretizer
-from .geometry import rear_end_global, rear_offsets
 
 
 @dataclass(frozen=True)
@@ -120,7 +120,7 @@ class TimeResponse:
         ax : matplotlib Axes, optional
         style : keyword arguments for ``Axes.plot``.
         """
-        from ..report.plotting import plot_time_response
+        from ..plotting.time import plot_time_response
         return plot_time_response(self, signals, ax=ax, **style)
 
 

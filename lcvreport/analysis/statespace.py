@@ -23,9 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.builder import check_speed, check_tire_scale, system_coefficients
 from ..model.vehicle import Vehicle
-from .geometry import rear_end_weights
+from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.outputs import rear_end_weights
 
 
 @dataclass(frozen=True)

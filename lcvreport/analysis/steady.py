@@ -10,10 +10,14 @@ Examples
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from ..model.builder import check_speed, check_tire_scale, system_coefficients
 from ..model.vehicle import Vehicle
+from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.outputs import point_lateral_map, point_longitudinal
+from ..ranges import RANGES, RangeError
 
 
 def steady_state(vehicle: Vehicle, speed_mps: float | np.ndarray, F: np.ndarray,
@@ -39,3 +43,87 @@ def steady_state(vehicle: Vehicle, speed_mps: float | np.ndarray, F: np.ndarray,
     S = system_coefficients(vehicle).S(speed_mps, tire_scale)
     Fb = np.broadcast_to(np.asarray(F, dtype=float), S.shape[:-1])
     return -np.linalg.solve(S, Fb[..., None])[..., 0]
+
+
+@dataclass(frozen=True)
+class Trim:
+    """Trimmed straight running under residual loads.
+
+    Attributes
+    ----------
+    delta_rad : float
+        Steer angle that holds the tractor straight (r1 = 0) [rad].
+    offtracking_m : float
+        Lateral offset of the rearmost axle's path from the steered axle's path [m], +y positive.
+    state : numpy.ndarray, shape (2N,)
+        The trimmed state (v1 m/s, r = 0, theta rad).
+    """
+
+    delta_rad: float
+    offtracking_m: float
+    state: np.ndarray
+
+
+def reference_points(vehicle: Vehicle) -> tuple[tuple[int, float], tuple[int, float]]:
+    """((unit, x) of the frontmost steered axle (or frontmost axle of unit 1),
+    (unit, x) of the rearmost axle of the last unit), 0-based units, x [m]."""
+    first = vehicle.steered_axles or vehicle.units[0].axles
+    q = max(first, key=lambda a: a.x_m)
+    last = vehicle.n_units - 1
+    return (0, q.x_m), (last, vehicle.units[last].rearmost_axle.x_m)
+
+
+def steady_with_yaw_rate(vehicle: Vehicle, speed_mps: float, F, r1: float, tire_scale: float = 1.0
+                         ) -> tuple[np.ndarray, float]:
+    """The steady state and steer angle with the tractor's yaw rate held at ``r1`` [rad/s]:
+    ``S x + b delta + F = 0`` with ``x[1] = r1`` (the trim: r1 = 0; a steady turn: u/R).
+
+    Returns
+    -------
+    x : numpy.ndarray, shape (2N,)
+    delta : float
+        [rad]
+    """
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    co = system_coefficients(vehicle)
+    S, b = co.S(speed_mps, tire_scale), co.B_delta(tire_scale)
+    n = vehicle.n_states
+    K = np.zeros((n + 1, n + 1))
+    K[:n, :n] = S
+    K[:n, n] = b
+    K[n, 1] = 1.0
+    rhs = np.concatenate([-np.asarray(F, dtype=float), [float(r1)]])
+    sol = np.linalg.solve(K, rhs)
+    return sol[:n], float(sol[n])
+
+
+def trim(vehicle: Vehicle, speed_mps: float, F: np.ndarray, tire_scale: float = 1.0) -> Trim:
+    """Trimmed straight running under a constant generalized force F (SI).
+
+    Solves ``S x + b delta + F = 0`` with ``r1 = 0`` for ``x`` and ``delta``.
+    """
+    x, delta = steady_with_yaw_rate(vehicle, speed_mps, F, 0.0, tire_scale)
+    (uq, xq), (up, xp) = reference_points(vehicle)
+    nu = vehicle.n_units
+    Theta = np.cumsum(x[nu + 1:])
+    lateral = lambda unit, xx: float(point_lateral_map(vehicle, unit, xx)[2:] @ Theta)  # noqa: E731 (psi1 = Y1 = 0)
+    dX = point_longitudinal(vehicle, up, xp) - point_longitudinal(vehicle, uq, xq)
+    offtracking = lateral(up, xp) - lateral(uq, xq) - dX * x[0] / speed_mps
+    return Trim(delta, float(offtracking), x)
+
+
+def check_trim(tr: Trim) -> None:
+    """Refuse a trim outside the ranges table: a trim steer beyond [-1, 1] rad is no longer
+    a small angle, and the linear model's answer means nothing (a unit typo, such as a
+    cornering stiffness in kN/rad, is the usual cause).
+
+    Raises
+    ------
+    RangeError
+    """
+    r = RANGES["steer_angle"]
+    if not r.contains(tr.delta_rad):
+        raise RangeError("trim.delta_rad", f"the trim steer angle {tr.delta_rad:.4g} rad is outside {r.text()}: the "
+                                           "linear model does not hold there; check the vehicle file's units "
+                                           "(cornering stiffness per tire in N/rad, masses in kg)")

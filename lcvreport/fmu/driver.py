@@ -1,6 +1,6 @@
 """The driver FMU: a path-following driver (FMI 2.0, Co-Simulation and Model Exchange, C99),
 built from ``fmu_src/c/driver.c`` with the start values of
-:data:`lcvreport.analysis.driver.DEFAULT` (SPEC section 15, the SSP example).
+:data:`lcvreport.manoeuvres.drivers.DEFAULT` (SPEC section 15, the SSP example).
 
 Examples
 --------
@@ -17,9 +17,10 @@ import uuid
 from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
-from ..analysis.driver import DEFAULT
-from .build import _compile, _zip, documentation_files, fmi_header_dir, source_dir
-from .model_description import _num
+from ..manoeuvres.drivers import DEFAULT
+from .c_sources import _compile, fmi_header_dir, source_dir
+from .description_common import _num
+from .package import _zip, documentation_files
 
 MODEL_IDENTIFIER = "PreviewDriver"
 SOURCES = ("driver.c", "fmi2_shared.c")
@@ -49,7 +50,7 @@ def driver_model_description(fmu_guid: str) -> bytes:
     root = Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": MODEL_IDENTIFIER, "guid": fmu_guid,
         "description": "Path-following driver with preview: delta = K (Y_ref(t) - (Y1 + L psi1)), a half-cosine lane "
-                       "change as the reference (lcvreport.analysis.driver.PreviewDriver).",
+                       "change as the reference (lcvreport.manoeuvres.drivers.PreviewDriver).",
         "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": "lcvreport.fmu.driver (C99)",
         "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
     for tag, extra in (("ModelExchange", {"completedIntegratorStepNotNeeded": "true"}),
@@ -111,6 +112,6 @@ def build_driver_fmu(out_dir: str | Path) -> Path:
             files[f"sources/{s}"] = (src / s).read_bytes()
 
         class _Itf:
-            description = "Path-following driver with preview (lcvreport.analysis.driver.PreviewDriver)."
+            description = "Path-following driver with preview (lcvreport.manoeuvres.drivers.PreviewDriver)."
         files.update(documentation_files(_Itf, MODEL_IDENTIFIER, native=True))
         return _zip(out_dir / f"{MODEL_IDENTIFIER}.fmu", files)

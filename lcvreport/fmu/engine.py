@@ -36,8 +36,8 @@ import math
 import numpy as np
 
 from ..analysis.discretize import augmented_state_matrix
-from ..analysis.geometry import point_lateral_map, rear_end_weights
-from ..model.builder import system_coefficients
+from ..model.yaw_plane.equations import system_coefficients
+from ..model.yaw_plane.outputs import point_lateral_map, rear_end_weights
 from ..ranges import RANGES, RangeError
 from ..util.cache import LRUCache
 from ..util.numerics import expm

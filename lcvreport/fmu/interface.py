@@ -3,7 +3,7 @@
 One :class:`FmuVariable` per variable (name, value reference, causality,
 variability, type, unit, display unit, start, description, and the *source* the
 engine reads it from).  Both modelDescription.xml files
-(:mod:`lcvreport.fmu.model_description`), the C header's ``ValueReference`` enum
+(:mod:`lcvreport.fmu.description_fmi2`), the C header's ``ValueReference`` enum
 (:mod:`lcvreport.fmu.build`), the pythonfmu slave's registration and the engine's
 output addressing (:mod:`lcvreport.fmu.engine`) are generated from this table,
 the way FMPy's ``ModelVariable`` has one writer and Reference-FMUs' ``config.h``
@@ -36,7 +36,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.presets import PRESETS
-from ..model.vehicle import Vehicle, joint_letter
+from ..model.vehicle import Vehicle
+from ..model.yaw_plane.states import joint_letter
 from ..ranges import RANGES
 
 #: default forward speed [m/s] (50 mph = 22.352 m/s exactly)
@@ -174,8 +175,8 @@ class Interface:
         (fmusim's CVODE: atol = rtol x nominal), so states of a few milliradians are resolved.
         Computed at build time (the FMU's runtime does not compute it)."""
         from ..analysis.exact import response
-        from ..analysis.manoeuvres import sine, step
-        from ..model.builder import system_coefficients
+        from ..manoeuvres.steer import sine, step
+        from ..model.yaw_plane.equations import system_coefficients
         u = float(self.by_name["u"].start)
         peaks = np.zeros(len(self.continuous_states))
         for v in self.vehicles:

@@ -2,8 +2,8 @@
 
 :class:`SlaveCore` holds the variables, parameters, inputs and the
 :class:`lcvreport.fmu.engine.LCVEngine` of one instance and answers the calls by value
-reference; the adapters put it behind pythonfmu (FMI 2.0, :mod:`lcvreport.fmu.slave`) and
-pythonfmu3 (FMI 3.0, :mod:`lcvreport.fmu.slave3`) and say how a message is logged and how the
+reference; the adapters put it behind pythonfmu (FMI 2.0, :mod:`lcvreport.fmu.slave_fmi2`) and
+pythonfmu3 (FMI 3.0, :mod:`lcvreport.fmu.slave_fmi3`) and say how a message is logged and how the
 FMI functions are spelled.  ``resources/lcv_fmu.json`` says which interface: the six presets
 (SPEC section 5) or one vehicle built in (SPEC section 9).
 

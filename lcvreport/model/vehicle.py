@@ -45,11 +45,16 @@ from dataclasses import dataclass, field, replace
 from numbers import Integral, Real
 
 from ..ranges import GYRATION_PER_REACH_MIN, VEHICLE, RangeError
+from .yaw_plane.states import joint_letter, state_names
 
 #: names the vehicle itself may have (it is also the FMU's model name)
 VEHICLE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+
+
 #: unit names: no commas or spaces (they are listed as --load trailer1,dolly1)
 UNIT_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*\Z")
+
+
 #: axle names: they become FMU variable names P_<axle>, T_<axle>
 AXLE_NAME = re.compile(r"[A-Za-z0-9_]+\Z")
 
@@ -74,24 +79,6 @@ class VehicleError(ValueError):
     def at(self, where: str) -> "VehicleError":
         """The same error located at ``where`` (prefixed to any location it has)."""
         return VehicleError(self.key, self.bare, f"{where} {self.where}".strip())
-
-
-def joint_letter(k: int) -> str:
-    """Letter of joint ``k`` (0-based: A, B, ..., Z, AA, AB, ...), as in thesis Table 3-2."""
-    if k < 0:
-        raise ValueError("joint index must be >= 0")
-    letters = ""
-    k += 1
-    while k:
-        k, rem = divmod(k - 1, 26)
-        letters = chr(ord("A") + rem) + letters
-    return letters
-
-
-def state_names(n_units: int) -> tuple[str, ...]:
-    """Names of the state ``x = [v1, r1..rN, thetaA..]`` of an N-unit chain."""
-    return ("v1",) + tuple(f"r{i + 1}" for i in range(n_units)) + tuple(
-        f"theta{joint_letter(k)}" for k in range(n_units - 1))
 
 
 def _number(key: str, value, rng_key: str | None = None) -> float:

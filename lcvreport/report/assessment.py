@@ -1,7 +1,7 @@
 """The assessment report of one vehicle at one speed: what its notebook shows.
 
 Rows of its tables and its figures, each computed by :mod:`lcvreport.analysis` and
-drawn by :mod:`lcvreport.report.plotting`; the notebook ``notebooks/assessment.ipynb``
+drawn by :mod:`lcvreport.plotting.vehicle`; the notebook ``notebooks/assessment.ipynb``
 only lays them out with captions that name the vehicle and the speed.
 
 Examples
@@ -17,14 +17,23 @@ from functools import cached_property
 
 import numpy as np
 
-from ..analysis import measures
+from ..analysis.frequency import RA_FREQUENCY_HZ, steer_to_acceleration
 from ..analysis.modes import Modes, modes
+from ..analysis.steady import trim
 from ..fmu.interface import vehicle_interface
+from ..measures.amplification import SingleSine, single_sine
+from ..measures.measure_set import MeasureSet, measure_set
+from ..measures.stability import SpeedSweep, speed_sweep
+from ..model.body import body_extent, unit_poses
 from ..model.presets import load_preset
 from ..model.vehicle import Vehicle
 from ..model.vehicle_file import load_vehicle
+from ..plotting.charts import fig_bars
+from ..plotting.frequency import fig_damping_over_speed, fig_frequency, fig_root_locus
+from ..plotting.time import fig_lane_change, fig_pulse
+from ..plotting.vehicle import fig_mode_shape, fig_vehicle
+from ..tracking.tires import AxleSensitivity, conicity_sensitivity
 from ..units import kph_to_mps
-from . import plotting
 
 #: speed range of the root locus and of the damping curve [km/h] (SPEC section 10)
 SWEEP_KPH = (10.0, 130.0)
@@ -53,8 +62,8 @@ class Assessment:
         """From a preset name or a vehicle file; ``source`` names it for captions (default:
         the preset or the file's path); ``residuals`` (``P_N``, ``T_Nm``,
         ``misalignment_rad`` by axle, ``crossfall_percent``) and a criteria file optional."""
-        from ..analysis.criteria import load_criteria
-        from ..model.loads import ResidualLoads, ResidualSources
+        from ..measures.criteria import load_criteria
+        from ..model.yaw_plane.loads import ResidualLoads, ResidualSources
         vehicle = load_preset(preset) if preset is not None else load_vehicle(vehicle_file)
         res = residuals or {}
         sources = ResidualSources(ResidualLoads(dict(res.get("P_N", {})), dict(res.get("T_Nm", {}))),
@@ -76,11 +85,11 @@ class Assessment:
 
     # ------------------------------------------------------------------ data
     def fig_vehicle(self):
-        fig = plotting.fig_vehicle(self.vehicle, f"{self.vehicle.name}: {self.vehicle.n_units} units")
-        poses = plotting.unit_poses(self.vehicle)
+        fig = fig_vehicle(self.vehicle, f"{self.vehicle.name}: {self.vehicle.n_units} units")
+        poses = unit_poses(self.vehicle)
         rows = []
         for k, ((cg, _psi), u) in enumerate(zip(poses, self.vehicle.units)):
-            front, rear, half = plotting.body_extent(self.vehicle, k)
+            front, rear, half = body_extent(self.vehicle, k)
             rows.append({"unit": u.name, "item": "CG", "x_m": cg[0], "half_width_m": ""})
             rows.append({"unit": u.name, "item": "drawn body front", "x_m": cg[0] + front, "half_width_m": half})
             rows.append({"unit": u.name, "item": "drawn body rear", "x_m": cg[0] + rear, "half_width_m": half})
@@ -126,7 +135,7 @@ class Assessment:
         return [int(i) for i in idx[np.argsort(m.damping_ratio[idx])][:count]]
 
     def fig_mode(self, index: int):
-        fig = plotting.fig_mode_shape(self.vehicle, self.modes, index, f"Mode {index + 1}")
+        fig = fig_mode_shape(self.vehicle, self.modes, index, f"Mode {index + 1}")
         lam = self.modes.eigenvalues[index]
         fig.lcv_data = [{"state": name, "eigenvalue_real_per_s": lam.real, "eigenvalue_imag_per_s": lam.imag,
                          "shape_real": x.real, "shape_imag": x.imag, "shape_magnitude": abs(x),
@@ -136,12 +145,12 @@ class Assessment:
 
     # ------------------------------------------------------------------ stability over speed
     @cached_property
-    def sweep(self) -> measures.SpeedSweep:
+    def sweep(self) -> SpeedSweep:
         lo, hi = SWEEP_KPH
-        return measures.speed_sweep(self.vehicle, np.linspace(lo, hi, 25 if self.fast else 121))
+        return speed_sweep(self.vehicle, np.linspace(lo, hi, 25 if self.fast else 121))
 
     def fig_root_locus(self):
-        fig = plotting.fig_root_locus(self.sweep.speeds_kph, self.sweep.eigenvalues,
+        fig = fig_root_locus(self.sweep.speeds_kph, self.sweep.eigenvalues,
                                       f"Root locus of {self.vehicle.name}, {SWEEP_KPH[0]:g}-{SWEEP_KPH[1]:g} km/h",
                                       self.sweep.critical_speed_kph)
         fig.lcv_data = [{"speed_kph": v, "mode": j + 1, "real_per_s": lam.real, "imag_per_s": lam.imag}
@@ -150,7 +159,7 @@ class Assessment:
         return fig
 
     def fig_damping(self):
-        fig = plotting.fig_damping_over_speed(self.sweep.speeds_kph, self.sweep.least_damping_ratio,
+        fig = fig_damping_over_speed(self.sweep.speeds_kph, self.sweep.least_damping_ratio,
                                               self.sweep.max_real, self.vehicle.name, self.sweep.critical_speed_kph,
                                               self.speed_kph)
         fig.lcv_data = [{"speed_kph": v, "least_damping_ratio": z, "max_real_per_s": m}
@@ -165,21 +174,21 @@ class Assessment:
 
     def fig_ra(self):
         f = self.frequencies_hz
-        G = np.abs(measures.steer_to_acceleration(self.vehicle, self.speed_mps, f))
+        G = np.abs(steer_to_acceleration(self.vehicle, self.speed_mps, f))
         curves = [(f"RA = |G_{self.vehicle.n_units}| / |G_1|", G[:, -1] / G[:, 0])]
         m = self.measures
-        fig = plotting.fig_frequency(f, curves, "rearward amplification [-]",
-                                     f"Rearward amplification of {self.at}", measures.RA_FREQUENCY_HZ,
+        fig = fig_frequency(f, curves, "rearward amplification [-]",
+                                     f"Rearward amplification of {self.at}", RA_FREQUENCY_HZ,
                                      peak=(m.ra_peak_frequency_hz, m.ra_peak))
         fig.lcv_data = [{"frequency_hz": fi, "rearward_amplification": ra} for fi, ra in zip(f, G[:, -1] / G[:, 0])]
         return fig
 
     def fig_gains(self):
         f = self.frequencies_hz
-        G = np.abs(measures.steer_to_acceleration(self.vehicle, self.speed_mps, f))
+        G = np.abs(steer_to_acceleration(self.vehicle, self.speed_mps, f))
         curves = [(f"|G_{i + 1}| {name}", G[:, i]) for i, name in enumerate(self.vehicle.unit_names)]
-        fig = plotting.fig_frequency(f, curves, "lateral acceleration per steer angle [m/s²/rad]",
-                                     f"Steer-to-lateral-acceleration gains of {self.at}", measures.RA_FREQUENCY_HZ,
+        fig = fig_frequency(f, curves, "lateral acceleration per steer angle [m/s²/rad]",
+                                     f"Steer-to-lateral-acceleration gains of {self.at}", RA_FREQUENCY_HZ,
                                      logy=True)
         fig.lcv_data = [{"frequency_hz": fi, **{f"gain_{name}_m_per_s2_per_rad": g for name, g in
                                                 zip(self.vehicle.unit_names, row)}} for fi, row in zip(f, G)]
@@ -194,24 +203,24 @@ class Assessment:
         return fig
 
     @cached_property
-    def single_sine(self) -> measures.SingleSine:
-        return measures.single_sine(self.vehicle, self.speed_mps)
+    def single_sine(self) -> SingleSine:
+        return single_sine(self.vehicle, self.speed_mps)
 
     # ------------------------------------------------------------------ measures and conicity
     @cached_property
-    def measures(self) -> measures.MeasureSet:
-        return measures.measure_set(self.vehicle, self.speed_mps, load_units=list(self.load_units) or None,
+    def measures(self) -> MeasureSet:
+        return measure_set(self.vehicle, self.speed_mps, load_units=list(self.load_units) or None,
                                     sources=self.sources)
 
     # ------------------------------------------------------------------ manoeuvres (SPEC 11-12)
     @cached_property
     def lane_change(self):
-        from ..analysis.field_measures import lane_change_measures
+        from ..measures.offtracking import lane_change_measures
         return lane_change_measures(self.vehicle, self.speed_mps)
 
     def fig_lane_change(self):
         lc = self.lane_change
-        fig = plotting.fig_lane_change(lc, f"Lane change 0.15 g at 0.4 Hz of {self.at}")
+        fig = fig_lane_change(lc, f"Lane change 0.15 g at 0.4 Hz of {self.at}")
         r = lc.response
         fig.lcv_data = [{"time_s": t, "steer_angle_rad": d, f"Y_{lc.steered_axle}_m": a, f"Y_{lc.rear_axle}_m": b,
                          "a_steer_m_per_s2": c, f"ay{self.vehicle.n_units}_m_per_s2": e}
@@ -222,13 +231,13 @@ class Assessment:
 
     @cached_property
     def yaw_damping(self):
-        from ..analysis.field_measures import yaw_damping_coefficient
+        from ..measures.yaw_damping import yaw_damping_coefficient
         return yaw_damping_coefficient(self.vehicle, self.speed_mps)
 
     def fig_pulse(self):
         names = list(self.vehicle.state_names[self.vehicle.n_units + 1:])
         y = self.yaw_damping
-        fig = plotting.fig_pulse(y, names, f"Pulse steer 0.01 rad, 0.5 s: articulation of {self.at} (dots: the "
+        fig = fig_pulse(y, names, f"Pulse steer 0.01 rad, 0.5 s: articulation of {self.at} (dots: the "
                                            "extrema the ratio method uses)")
         rows = []
         for name, (t, v), zeta in zip(names, y.extrema, y.per_joint):
@@ -240,7 +249,7 @@ class Assessment:
 
     @cached_property
     def steady_turn(self):
-        from ..analysis.field_measures import steady_turn
+        from ..measures.offtracking import steady_turn
         return steady_turn(self.vehicle, self.speed_mps)
 
     def turn_rows(self) -> list[dict]:
@@ -252,14 +261,14 @@ class Assessment:
                 for i, a in zip(self.vehicle.axle_units, self.vehicle.axles)]
 
     def verdict_rows(self) -> list[dict]:
-        from ..analysis.criteria import judge
+        from ..measures.criteria import judge
         doc = self.measures.to_dict()
         return [{"measure": k, "value": "" if v["value"] is None else v["value"], "limit": v["limit"],
                  "verdict": v["verdict"], "source": v["source"]} for k, v in judge(self.criteria, doc).items()]
 
     @cached_property
-    def sensitivity(self) -> list[measures.AxleSensitivity]:
-        return measures.conicity_sensitivity(self.vehicle, self.speed_mps)
+    def sensitivity(self) -> list[AxleSensitivity]:
+        return conicity_sensitivity(self.vehicle, self.speed_mps)
 
     def sensitivity_rows(self) -> list[dict]:
         return [{"rank": k + 1, "axle": s.axle, "unit": s.unit,
@@ -271,7 +280,7 @@ class Assessment:
 
     def fig_sensitivity(self):
         rows = self.sensitivity
-        fig = plotting.fig_bars([f"{s.axle} ({s.unit})" for s in rows],
+        fig = fig_bars([f"{s.axle} ({s.unit})" for s in rows],
                                  [("per kN of P", np.array([1e3 * s.offtracking_per_P_m_per_kN for s in rows])),
                                   ("per kN·m of T", np.array([1e3 * s.offtracking_per_T_m_per_kNm for s in rows]))],
                                  "trimmed offtracking [mm]", f"Conicity sensitivity of {self.at}, ranked",
@@ -282,8 +291,9 @@ class Assessment:
     # ------------------------------------------------------------------ low-speed turn (SPEC 16)
     @cached_property
     def low_speed_turn(self):
-        """:class:`lcvreport.analysis.low_speed_turn.LowSpeedTurn`, or the reason it is not computed (str)."""
-        from ..analysis.low_speed_turn import TurnError, low_speed_turn
+        """:class:`lcvreport.measures.low_speed.LowSpeedTurn`, or the reason it is not computed (str)."""
+        from ..measures.low_speed import low_speed_turn
+        from ..model.body import TurnError
         try:
             return low_speed_turn(self.vehicle)
         except TurnError as exc:
@@ -298,8 +308,8 @@ class Assessment:
     # ------------------------------------------------------------------ straight-line tracking (SPEC 13)
     def _tire_force(self) -> np.ndarray:
         """The generalized force of the mounted tires alone (SI)."""
-        from ..analysis.tracking import axle_residuals
-        from ..model.loads import ResidualSources
+        from ..model.yaw_plane.loads import ResidualSources
+        from ..tracking.tires import axle_residuals
         return ResidualSources(axle_residuals(self.vehicle, self.tracking["tires"])).vector(self.vehicle)
 
     def _other_force(self) -> np.ndarray | None:
@@ -313,8 +323,8 @@ class Assessment:
 
     @cached_property
     def tracking_stats(self):
-        """:class:`lcvreport.analysis.tracking.TrackingStats` of the report's specification, or None."""
-        from ..analysis.tracking import stats_from_spec
+        """:class:`lcvreport.tracking.statistics.TrackingStats` of the report's specification, or None."""
+        from ..tracking.statistics import stats_from_spec
         if not self.tracking or not self.tracking.get("stats") or not self.vehicle.steered_axles:
             return None
         spec = dict(self.tracking["stats"])
@@ -352,7 +362,7 @@ class Assessment:
 
     def mounted_tire_rows(self) -> list[dict]:
         """The mounted tires and their axles' P and T (SI)."""
-        from ..analysis.tracking import axle_residuals
+        from ..tracking.tires import axle_residuals
         tires = self.tracking["tires"]
         loads = axle_residuals(self.vehicle, tires)
         rows = [{"position": t["position"], "tire": t.get("id", ""), "serial_side": t["serial_side"],
@@ -368,8 +378,8 @@ class Assessment:
     @cached_property
     def placement(self):
         """The mounting plan of the mounted tires over their own positions
-        (:func:`lcvreport.analysis.placement.place_tires`), or None."""
-        from ..analysis.placement import place_tires
+        (:func:`lcvreport.tracking.placement.place_tires`), or None."""
+        from ..tracking.placement import place_tires
         if not self.tracking or not self.tracking.get("tires") or not self.vehicle.steered_axles:
             return None
         tires = self.tracking["tires"]
@@ -386,12 +396,12 @@ class Assessment:
 
     def tracking_comparison_rows(self) -> list[dict]:
         """Offtracking of the tires as mounted, as planned and over random placements, against the margin."""
-        from ..analysis.tracking import BODY_WIDTH_M, LANE_WIDTH_M
+        from ..tracking.statistics import BODY_WIDTH_M, LANE_WIDTH_M
         spec = (self.tracking or {}).get("stats") or {}
         margin = 0.5 * (float(spec.get("lane_width_m", LANE_WIDTH_M)) - float(spec.get("body_width_m", BODY_WIDTH_M)))
         pl = self.placement
         F_other = self._other_force()
-        as_mounted = measures.trim(self.vehicle, self.speed_mps, self._tire_force() +
+        as_mounted = trim(self.vehicle, self.speed_mps, self._tire_force() +
                                    (0 if F_other is None else F_other))
         r = pl.to_dict()["random_placements"]
         return [{"tires": "as mounted (the file)", "offtracking_m": as_mounted.offtracking_m,
@@ -411,7 +421,7 @@ class Assessment:
         """The first page's summary: the vehicle's description and the headline measures."""
         m = self.measures
         lines = []
-        from .reporting import md_text
+        from .tables import md_text
         if self.vehicle.description:
             lines += [f"*{md_text(self.vehicle.name)}*: {md_text(self.vehicle.description)}", ""]
         lines += [f"At {self.speed_kph:g} km/h ({md_text(self.source)}):", ""]

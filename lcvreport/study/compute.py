@@ -20,8 +20,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.batch import VariantBatch
-from ..analysis.measures import RA_FREQUENCY_HZ, measure_set
-from ..analysis.registry import BATCHED as BATCH_GROUPS
+from ..analysis.frequency import RA_FREQUENCY_HZ
+from ..measures.measure_set import measure_set
+from ..measures.registry import BATCHED as BATCH_GROUPS
 from .spec import BATCHED, Study
 
 
@@ -72,7 +73,7 @@ def compute_chunk(study: Study, case_ids) -> dict:
 def _case_force(study: Study, case_id: int) -> np.ndarray:
     """The generalized force F [SI] of a case's load case and residual sources, as measure_set
     builds it for the trim (with the case's own masses and tire coefficients); NaN if none."""
-    from ..model.loads import load_vector, one_percent_rule
+    from ..model.yaw_plane.loads import load_vector, one_percent_rule
     vehicle, _speed, kwargs = study.case(case_id)
     units, sources = kwargs.get("load_units"), kwargs.get("sources")
     if not units and not sources:

@@ -19,23 +19,10 @@ Examples
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-from .run import CHUNKS, MANIFEST, STUDY, chunk_name
+from .folder import CHUNKS, MANIFEST, STUDY, _json, chunk_name
 from .spec import StudyError, study_from_stored
-
-
-def _json(path: Path) -> dict:
-    """A JSON document of a study folder (through the guarded reader: a FIFO never blocks)."""
-    from ..util.files import read_text_file
-    try:
-        doc = json.loads(read_text_file(path, "study's JSON file", 64 << 20))
-    except ValueError as exc:
-        raise StudyError(f"{path} cannot be read: {exc}") from None
-    if not isinstance(doc, dict):
-        raise StudyError(f"{path} cannot be read: not a JSON object")
-    return doc
 
 
 def _manifest(folder: Path) -> dict:
@@ -48,7 +35,7 @@ def _checked(folder: Path) -> tuple[dict, object]:
     """The manifest and the stored study of ``folder``, checked against each other: the
     manifest must describe the study that ``study.json`` holds (its digest, its cases and
     chunks), so an edited manifest cannot make part of a study read as all of it."""
-    from .run import FORMAT
+    from .folder import FORMAT
     man = _manifest(folder)
     study = stored_study(folder)
     if man.get("format") != FORMAT or man.get("study_sha256") != study.digest():
@@ -88,6 +75,7 @@ def read_study(folder, complete: bool = True):
     import numpy as np
     import pandas as pd
     import pyarrow.parquet as pq
+
     from .run import chunk_problem
     folder = Path(folder)
     man, study = _checked(folder)

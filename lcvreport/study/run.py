@@ -36,16 +36,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from .folder import CHUNKS, FORMAT, MANIFEST, STUDY, chunk_name
 from .spec import Study, StudyError
-
-MANIFEST = "manifest.json"
-STUDY = "study.json"
-CHUNKS = "chunks"
-FORMAT = "lcvreport-study/1"
-
-
-def chunk_name(k: int) -> str:
-    return f"chunk-{k:06d}.parquet"
 
 
 @dataclass
@@ -87,6 +79,7 @@ def write_chunk(study: Study, k: int, start: int, stop: int, folder: Path) -> Pa
     import numpy as np
     import pyarrow as pa
     import pyarrow.parquet as pq
+
     from .compute import compute_chunk
     cols = compute_chunk(study, np.arange(start, stop))
     table = pa.table(cols).replace_schema_metadata(_chunk_metadata(study.digest(), k, start, stop))
@@ -163,7 +156,7 @@ def _prepare(study: Study, out: Path) -> Path:
         manifest = out / MANIFEST
         if not manifest.is_file():
             raise StudyError(f"--out {out} holds files that are not a study's results; give a new or empty folder")
-        from .results import _json
+        from .folder import _json
         try:
             old = _json(manifest)
         except StudyError:
@@ -323,6 +316,7 @@ def probe_scheduler(address: str, timeout_s: float = SCHEDULER_TIMEOUT_S) -> dic
         Nothing listens there, the peer does not answer in time, or it is not a Dask scheduler.
     """
     import asyncio
+
     from distributed.comm import connect
 
     async def ask():
@@ -379,6 +373,7 @@ class _workers_quiet:
 
 def _run_distributed(study, todo, bounds, chunks, workers, scheduler, bar) -> None:
     import logging
+
     from dask.distributed import Client, LocalCluster, as_completed
     logging.getLogger("distributed").setLevel(logging.CRITICAL)     # failures reach us through the futures
     doc = study.to_dict()

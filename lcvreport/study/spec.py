@@ -47,7 +47,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.registry import BATCHED as _BATCH_GROUPS, CRITERIA_KEYS, unknown_key_message
+from ..measures.registry import BATCHED as _BATCH_GROUPS
+from ..measures.registry import CRITERIA_KEYS, unknown_key_message
 from ..model.vehicle import Vehicle, VehicleError
 from ..model.vehicle_file import dumps_vehicle, load_vehicle, loads_vehicle
 from ..ranges import RANGES, RangeError
@@ -306,8 +307,8 @@ class Study:
 
     def sources(self, table: dict, k: int):
         """The residual sources (SPEC section 11) of row ``k`` of ``table``: a
-        :class:`~lcvreport.model.loads.ResidualSources` (empty when the study has none)."""
-        from ..model.loads import ResidualLoads, ResidualSources
+        :class:`~lcvreport.model.yaw_plane.loads.ResidualSources` (empty when the study has none)."""
+        from ..model.yaw_plane.loads import ResidualLoads, ResidualSources
         P, T, eps, cross = {}, {}, {}, 0.0
         for name, arr in table.items():
             key = residual_key(name)

@@ -1,11 +1,11 @@
 """What a study's table says: the spread of each measure, and how many cases pass a criteria
 file's limits -- overall and along each factor (the study report's tables; drawing is in
-:mod:`lcvreport.report.plotting`).
+:mod:`lcvreport.plotting.vehicle`).
 
 Examples
 --------
 >>> import pandas as pd
->>> from lcvreport.analysis.criteria import Criteria, Limit
+>>> from lcvreport.measures.criteria import Criteria, Limit
 >>> t = pd.DataFrame({"case_id": [0, 1, 2, 3], "speed_kph": [80.0, 80.0, 100.0, 100.0],
 ...                   "hsso_m": [0.1, 0.2, 0.4, None]})
 >>> quantile_rows(t, ["hsso_m"])[0]["undefined"]
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.criteria import judge_values, lower_bounds_of
+from ..measures.criteria import judge_values, lower_bounds_of
 
 QUANTILES = (0.0, 0.05, 0.5, 0.95, 1.0)
 
@@ -59,7 +59,7 @@ class PassRates:
     by_factor: dict
 
     def plot(self):
-        from ..report.plotting import study_pass_rates
+        from ..plotting.study import study_pass_rates
         return study_pass_rates(self)
 
 

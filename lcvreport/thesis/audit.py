@@ -18,9 +18,9 @@ from scipy.optimize import linear_sum_assignment
 from ..analysis.modal import modal_coefficients
 from ..analysis.modes import eigenvalues
 from ..analysis.steady import steady_state
-from ..model.builder import system_matrices
-from ..model.loads import load_vector, one_percent_rule
 from ..model.presets import load_preset
+from ..model.yaw_plane.equations import system_matrices
+from ..model.yaw_plane.loads import load_vector, one_percent_rule
 from ..units import N_PER_LBF, THESIS, mph_to_mps
 from .tables import published
 

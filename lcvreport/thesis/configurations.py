@@ -24,8 +24,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..model.loads import ONE_PERCENT
 from ..model.vehicle import Vehicle
+from ..model.yaw_plane.loads import ONE_PERCENT
 
 #: load configurations of Figures 3-6..3-8 and 4-9..4-11
 CONFIGURATIONS = ("balanced", "unbalanced_vehicle", "unbalanced_trailer")

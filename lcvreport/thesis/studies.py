@@ -25,14 +25,14 @@ from functools import cached_property
 
 import numpy as np
 
-from ..analysis.geometry import rear_offsets
 from ..analysis.modal import modal_response
 from ..analysis.modes import eigenvalues
 from ..analysis.response import step_response
 from ..analysis.steady import steady_state
-from ..model.loads import load_vector, one_percent_rule
 from ..model.presets import load_preset
 from ..model.vehicle import Vehicle
+from ..model.yaw_plane.loads import load_vector, one_percent_rule
+from ..model.yaw_plane.outputs import rear_offsets
 from ..units import SI, THESIS, UnitSystem, m_to_in, mph_to_mps
 
 #: the thesis' end time, called steady state in chapter V [s]
@@ -135,7 +135,7 @@ class RunResult:
         return bool(np.all(self.eigenvalues.real < 0))
 
     def series(self, reading: str = "corrected") -> tuple[str, np.ndarray, np.ndarray, dict]:
-        """(label, time [s], y [in], line style) of one reading, for :func:`lcvreport.report.plotting.fig_time`:
+        """(label, time [s], y [in], line style) of one reading, for :func:`lcvreport.plotting.time.fig_time`:
         ``corrected`` (solid), ``published`` (dashed), ``thesis_loads`` (exact response to the thesis loads, dotted)."""
         if reading == "corrected":
             return self.run.label, self.t_corrected, self.y_corrected, {}
@@ -152,7 +152,7 @@ class RunResult:
 
     def plot(self, readings=("corrected", "published"), title: str = ""):
         """This run's time histories in the given readings (a Figure)."""
-        from ..report.plotting import fig_time
+        from ..plotting.time import fig_time
         return fig_time([self.series(r) for r in readings], f"{self.run.output} [in]", title or self.run.label,
                         hlines=[("true steady state (corrected)", self.steady_corrected)])
 
@@ -239,24 +239,24 @@ class Study:
         return [r.series(reading) for reading in (readings or ("corrected",)) for r in self.results]
 
     def eigenvalue_sets(self) -> list[tuple[str, np.ndarray]]:
-        """(label, eigenvalues [1/s]) per run, for :func:`lcvreport.report.plotting.fig_eigenvalues`."""
+        """(label, eigenvalues [1/s]) per run, for :func:`lcvreport.plotting.frequency.fig_eigenvalues`."""
         return [(r.run.label, r.eigenvalues) for r in self.results]
 
     def plot_responses(self, readings=("corrected",), title: str = "", **kw):
         """The runs' y6 time histories [in] (a Figure); keywords go to ``fig_time``."""
-        from ..report.plotting import fig_time
+        from ..plotting.time import fig_time
         return fig_time(self.series(*readings), "y6 [in]", title or self.parameter, **kw)
 
     def plot_eigenvalues(self, title: str = "", upper: bool = False, connect_mode: int | None = None):
         """The runs' eigenvalues (a Figure)."""
-        from ..report.plotting import fig_eigenvalues
+        from ..plotting.frequency import fig_eigenvalues
         return fig_eigenvalues(self.eigenvalue_sets(), title or f"Eigenvalues: {self.parameter}", upper, connect_mode)
 
     def plot_ranked(self, groups=(("corrected", "steady state, corrected"),
                                   ("thesis_loads", "steady state, thesis loads")), rank_by: str = "corrected",
                     title: str = "", peaks: bool = False):
         """Bar chart of |steady state| [in] per run, ranked (a Figure)."""
-        from ..report.plotting import fig_bars
+        from ..plotting.charts import fig_bars
         ranked = self.ranked(rank_by)
         bars = [("max transient, corrected", np.array([r.corrected_peak for r in ranked]))] if peaks else []
         bars += [(label, np.array([abs(r.steady(reading)) for r in ranked])) for reading, label in groups]

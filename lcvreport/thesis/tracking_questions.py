@@ -3,14 +3,14 @@
 The dissertation stops at one deterministic load, 1 % of the axle load, and names what it
 could not answer (sections 4.5, 5.5 and chapter VI): the real range of conicity and ply
 steer, whether sorting tires helps, and road crown as the confounder of its field test.
-This module answers them with :mod:`lcvreport.analysis.tracking` and
-:mod:`lcvreport.analysis.placement` on the aucnat preset at the thesis' 50 mph:
+This module answers them with :mod:`lcvreport.tracking.statistics` and
+:mod:`lcvreport.tracking.placement` on the aucnat preset at the thesis' 50 mph:
 
 * :func:`one_percent_against_population` -- the 1 % rule (trailers 2 and 3, the thesis'
   baseline; and every axle behind the tractor, all one way) against a tire population;
 * :func:`population_sensitivity` -- the answers as the assumed population is scaled;
 * :func:`mounting_study` -- serial sides all out, all in, at random, and the exact
-  mounting plan of drawn tire sets (:func:`lcvreport.analysis.placement.place_tires`);
+  mounting plan of drawn tire sets (:func:`lcvreport.tracking.placement.place_tires`);
 * :func:`crossfall_beside_conicity` -- road crossfall's trimmed offtracking beside the
   population's spread.
 
@@ -33,12 +33,13 @@ from importlib import resources
 
 import numpy as np
 
-from ..analysis.measures import trim
-from ..analysis.placement import place_tires
-from ..analysis.tracking import Distribution, TrackingStats, tire_slots, tracking_stats
-from ..model.loads import ResidualSources, load_vector, one_percent_rule
+from ..analysis.steady import trim
 from ..model.presets import load_preset
 from ..model.vehicle import Vehicle
+from ..model.yaw_plane.loads import ResidualSources, load_vector, one_percent_rule
+from ..tracking.placement import place_tires
+from ..tracking.statistics import Distribution, TrackingStats, tracking_stats
+from ..tracking.tires import tire_slots
 from ..units import m_to_in, mph_to_mps
 
 #: the thesis' speed of chapter V [mph]
@@ -183,7 +184,7 @@ class SensitivityAnswer:
         return out
 
     def plot(self):
-        from ..report.plotting import fig_tracking_sensitivity
+        from ..plotting.tracking import fig_tracking_sensitivity
         return fig_tracking_sensitivity(self)
 
 
@@ -221,7 +222,7 @@ class MountingAnswer:
         return out
 
     def plot(self):
-        from ..report.plotting import fig_mounting_study
+        from ..plotting.tracking import fig_mounting_study
         return fig_mounting_study(self)
 
 

@@ -19,8 +19,9 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..model.vehicle import Axle, Unit, Vehicle, joint_letter
+from ..model.vehicle import Axle, Unit, Vehicle
 from ..model.vehicle_file import dumps_vehicle
+from ..model.yaw_plane.states import joint_letter
 from ..units import M_PER_IN, N_PER_LBF, THESIS
 from .tables import dimensions, gaps, mass_table, tire_table
 

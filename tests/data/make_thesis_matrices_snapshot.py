@@ -1,7 +1,7 @@
 """Snapshot of the thesis-unit matrices built by commit 7c31b7f (before the SI core)."""
 import numpy as np
 from lcvreport.presets import PRESETS, load_preset
-from lcvreport.model import system_coefficients
+from lcvreport.model.yaw_plane.equations import system_coefficients
 from lcvreport.loads import one_percent_rule, load_vector
 out = {}
 speeds_in_per_s = np.array([88.0, 528.0, 880.0, 1232.0])  # 5, 30, 50, 70 mph

@@ -1,0 +1,1 @@
+"""The ``lcv`` command: one module per command group over the package."""

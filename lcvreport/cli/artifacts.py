@@ -1,0 +1,181 @@
+"""``lcv fmu``, ``lcv report`` and ``lcv study``: the commands that write folders of artifacts."""
+from __future__ import annotations
+
+import os
+import sys
+import time
+from pathlib import Path
+
+
+from ..ranges import RangeError
+from .options import UsageError, _load_units, _sources, _speed_mps, _vehicle
+from .output import OutputError, _Out
+
+
+def _cmd_fmu(args, out: _Out) -> int:
+    from ..fmu.build import build_vehicle_fmus
+    from ..fmu.c_sources import FmuBuildError
+    v = _vehicle(args)
+    try:
+        kw = {}
+        if args.speed_kph is not None or args.speed_mph is not None:
+            kw["u_start_mps"] = _speed_mps(args)      # the start value of the input u
+        kind = args.kind or "both"
+        paths = build_vehicle_fmus(v, args.out, kind=kind, fmi=int(args.fmi), **kw)
+    except FmuBuildError as exc:
+        raise OutputError(str(exc)) from None
+    for p in paths:
+        out.line(f"wrote {p}")
+    return 0
+
+
+def _cmd_report(args, out: _Out) -> int:
+    from ..report.build import build_assessment
+    from ..report.notebooks import ReportError
+    from ..report.publish import OutputFolderError, check_output_folder
+    try:
+        check_output_folder(args.out)          # before anything is computed
+    except OutputFolderError as exc:
+        raise UsageError(f"argument {exc}") from None
+    v = _vehicle(args)
+    speed = _speed_mps(args) if (args.speed_kph is not None or args.speed_mph is not None) else None
+    units = _load_units(args, v) if args.load is not None else None
+    if units:
+        from ..model.yaw_plane.loads import one_percent_rule
+        try:
+            one_percent_rule(v, units)
+        except ValueError as exc:
+            raise UsageError(f"argument --load: {exc}") from None
+    src = _sources(args, v)
+    try:
+        src.vector(v)
+    except (KeyError, RangeError) as exc:
+        raise UsageError(f"argument: {exc.args[0]}") from None
+    residuals = {"P_N": src.loads.P_N, "T_Nm": src.loads.T_Nm, "misalignment_rad": src.misalignment_rad,
+                 "crossfall_percent": src.crossfall_percent} if src else None
+    if args.criteria is not None:
+        from ..measures.criteria import CriteriaError, load_criteria
+        try:
+            load_criteria(args.criteria)
+        except CriteriaError as exc:
+            raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
+    tracking = {"tires": None, "stats": None}
+    if args.tires:
+        from ..tracking.tires import read_mounted_tires
+        tracking["tires"] = read_mounted_tires(args.tires)      # checked by _sources above
+        if not v.steered_axles:
+            raise UsageError(f"argument --tires: {v.name} has no steered axle: the trim needs one")
+    if args.tracking_stats is not None:
+        from ..tracking.statistics import parse_stats_spec
+        from ..tracking.tires import TrackingError
+        if not v.steered_axles:
+            raise UsageError(f"argument --tracking-stats: {v.name} has no steered axle: the trim needs one")
+        try:
+            tracking["stats"] = parse_stats_spec(args.tracking_stats)
+        except TrackingError as exc:
+            raise UsageError(f"argument --tracking-stats: {exc}") from None
+    text = None
+    if args.vehicle is not None:               # the user's file as written, comments and all
+        from ..model.vehicle_file import read_vehicle_text
+        text = read_vehicle_text(args.vehicle)
+    t0 = time.perf_counter()
+    try:
+        res = build_assessment(v, args.out, speed_mps=speed, load_units=units, pdf=not args.no_pdf,
+                               progress=lambda text: print(f"lcv report: {text}", file=sys.stderr, flush=True),
+                               source=args.vehicle or f"preset {args.preset}", vehicle_text=text, paper=args.paper,
+                               residuals=residuals, criteria_file=args.criteria,
+                               tracking=tracking if tracking["tires"] or tracking["stats"] else None)
+    except OutputFolderError as exc:
+        raise UsageError(f"argument {exc}") from None
+    except ReportError as exc:
+        raise OutputError(str(exc)) from None
+    for key in ("html", "pdf", "data"):
+        if key in res:
+            out.line(f"wrote {res[key]}")
+    print(f"lcv report: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    return 0
+
+
+def _cmd_study(args, out: _Out) -> int:
+    from ..study.run import run_study
+    from ..study.spec import StudyError, load_study
+    try:
+        study = load_study(args.study_file)
+    except StudyError as exc:
+        raise UsageError(str(exc) if str(args.study_file) in str(exc) else f"{args.study_file}: {exc}") from None
+    out_dir = Path(args.out)
+    if args.scheduler is not None:
+        from ..study.run import check_scheduler_address
+        try:
+            check_scheduler_address(args.scheduler)
+        except StudyError as exc:
+            raise UsageError(f"argument {exc}") from None
+    if (args.criteria is not None or args.no_pdf) and args.report is None:
+        raise UsageError("arguments --criteria and --no-pdf belong to --report REPORT_DIR")
+    if args.report is not None:
+        from ..report.publish import OutputFolderError, check_output_folder
+        try:
+            check_output_folder(args.report)
+        except OutputFolderError as exc:
+            raise UsageError(f"argument --report: {exc}") from None
+        if Path(args.report).resolve() == out_dir.resolve():
+            raise UsageError("argument --report: give another folder than --out")
+    if args.criteria is not None:
+        from ..measures.criteria import CriteriaError, load_criteria
+        try:
+            load_criteria(args.criteria)
+        except CriteriaError as exc:
+            raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
+    csv_path = out_dir / "results.csv"
+    if args.csv and (csv_path.exists() or csv_path.is_symlink()):
+        raise UsageError(f"argument --csv: {csv_path} exists; lcv never overwrites a file (move it, or omit --csv)")
+    if not args.json:
+        seed = f", seed {study.seed}" if study.seed is not None else ""
+        out.line(f"study of {study.vehicle.name}: {study.kind} design{seed}, {study.n_cases} cases in "
+                 f"{study.n_chunks} chunks of {study.chunk}; measures {', '.join(study.measures)}")
+        for f in study.factors:
+            out.line(f"  {f.describe()}")
+        out.stream.flush()
+    try:
+        summary = run_study(study, out_dir, workers=args.workers, scheduler=args.scheduler)
+    except StudyError as exc:
+        raise UsageError(str(exc)) from None
+    if args.csv:
+        from ..study.results import read_study
+        tmp = out_dir / ".results.csv.tmp"
+        read_study(out_dir).to_csv(tmp, index=False, float_format="%.17g")
+        try:
+            os.link(tmp, csv_path)
+        except FileExistsError:
+            raise UsageError(f"argument --csv: {csv_path} appeared meanwhile; nothing was overwritten") from None
+        finally:
+            tmp.unlink()
+    report = None
+    if args.report is not None:
+        from ..report.build import build_study_report
+        from ..report.notebooks import ReportError
+        from ..report.publish import OutputFolderError
+        try:
+            report = build_study_report(out_dir, args.report, criteria_file=args.criteria, pdf=not args.no_pdf,
+                                        progress=lambda text: print(f"lcv study: report: {text}", file=sys.stderr,
+                                                                    flush=True))
+        except OutputFolderError as exc:
+            raise UsageError(f"argument --report: {exc}") from None
+        except ReportError as exc:
+            raise OutputError(str(exc)) from None
+    doc = {"out": str(out_dir), "n_cases": summary.n_cases, "n_chunks": summary.n_chunks,
+           "chunks_computed": summary.n_computed, "chunks_found": summary.n_found, "seconds": summary.seconds,
+           "seed": study.seed}
+    if report is not None:
+        doc["report"] = {k: str(v) for k, v in report.items() if k != "seconds"}
+    if args.json:
+        out.json(doc)
+    else:
+        for key in ("html", "pdf"):
+            if report is not None and key in report:
+                out.line(f"wrote {report[key]}")
+        rate = (summary.n_computed and summary.n_cases * summary.n_computed / summary.n_chunks / summary.seconds)
+        out.line(f"{summary.n_computed} chunks computed, {summary.n_found} found done, in {summary.seconds:.1f} s"
+                 + (f" ({rate:.0f} cases/s)" if rate else "") + f"; results in {out_dir}"
+                 + (f", {csv_path.name}" if args.csv else ""))
+    return 0

@@ -1,0 +1,88 @@
+"""``lcv measures``: every measure of the registry as text, CSV or JSON, judged against
+``--criteria``.
+"""
+from __future__ import annotations
+
+
+
+from ..units import mps_to_kph
+from .options import UsageError, _load_units, _parse_speeds, _sources, _vehicle
+from .output import _finite, _Out
+
+
+def _cmd_measures(args, out: _Out) -> int:
+    from ..measures.criteria import CriteriaError, judge, load_criteria
+    from ..measures.measure_set import measure_set
+    v = _vehicle(args)
+    speeds, unit = _parse_speeds(args)
+    units = _load_units(args, v) if args.load is not None else None
+    sources = _sources(args, v)
+    criteria = None
+    if args.criteria is not None:
+        try:
+            criteria = load_criteria(args.criteria)
+        except CriteriaError as exc:
+            raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
+    docs, sets = [], []
+    for u in speeds:
+        try:
+            m = measure_set(v, u, args.tire_scale, units, sources=sources if sources else None)
+        except ValueError as exc:
+            if "static_load_N" in str(exc):
+                raise UsageError(f"argument --load: {exc}") from None
+            raise
+        doc = m.to_dict()
+        if criteria is not None:
+            doc["verdicts"] = judge(criteria, doc)
+        docs.append(doc)
+        sets.append(m)
+    for doc in docs:
+        _finite(*(val for val in doc.values() if isinstance(val, (int, float))),
+                *(val for val in doc.values() if isinstance(val, list) and val and not isinstance(val[0], dict)))
+    sweep = len(speeds) > 1
+    if args.json:
+        out.json(docs if sweep else docs[0])
+        return 0
+    if sweep:
+        cols = _flat_columns(docs[0], v)
+        out.line(",".join(cols))
+        for doc in docs:
+            flat = _flatten(doc, v)
+            out.line(",".join("" if flat.get(c) is None else (f"{flat[c]:.10g}" if isinstance(flat[c], float)
+                                                             else str(flat[c])) for c in cols))
+        return 0
+    m, doc = sets[0], docs[0]
+    out.line(f"{v.name} at {args.speed_kph or args.speed_mph} {unit} ({mps_to_kph(m.speed_mps):.1f} km/h), tire scale "
+             f"{args.tire_scale:g}")
+    for row in m.rows():
+        val = row["value"]
+        text = val if isinstance(val, str) else f"{val:.6g}"
+        out.line(f"  {row['measure']:42s} {text:>12s} {row['unit']:10s} {row['note']}")
+    if criteria is not None:
+        out.line(f"verdicts against {args.criteria} (limits and their sources as the file gives them):")
+        for key, verdict in doc["verdicts"].items():
+            out.line(f"  {key:28s} {verdict['verdict']:14s} {verdict['note']}")
+    return 0
+
+
+def _flatten(doc: dict, vehicle) -> dict:
+    flat = {}
+    for key, val in doc.items():
+        if key == "ay_gain_per_unit":
+            for name, g in zip(vehicle.unit_names, val or [None] * vehicle.n_units):
+                flat[f"ay_gain_{name}_m_per_s2_per_rad"] = g
+        elif key == "trim":                      # the registry's keys (trim.delta_rad, trim.offtracking_m)
+            flat["trim.delta_rad"] = None if val is None else val["delta_rad"]
+            flat["trim.offtracking_m"] = None if val is None else val["offtracking_m"]
+        elif key == "verdicts":
+            for k, verdict in val.items():
+                flat[f"verdict_{k}"] = verdict["verdict"]
+        elif key == "reasons":                   # the text output and the JSON say why; a CSV cell is a number
+            continue
+        else:
+            flat[key] = val
+    return flat
+
+
+def _flat_columns(doc: dict, vehicle) -> list[str]:
+    return list(_flatten(doc, vehicle))

@@ -1,0 +1,93 @@
+"""``lcv presets``, ``lcv eig``, ``lcv matrices`` and ``lcv steady``: the model itself."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..units import SI, THESIS
+from .options import _load_vector, _speed_mps, _speed_text, _vehicle
+from .output import _finite, _Out
+
+
+# ---------------------------------------------------------------------------- commands
+def _cmd_presets(args, out: _Out) -> int:
+    from ..model.presets import PRESET_LABELS, PRESETS
+    if args.json:
+        out.json({"presets": list(PRESETS)})
+    else:
+        for name in PRESETS:
+            out.line(f"{name:22s} {PRESET_LABELS[name]}")
+    return 0
+
+
+def _cmd_eig(args, out: _Out) -> int:
+    from ..analysis.modes import modes
+    v = _vehicle(args)
+    m = modes(v, _speed_mps(args), args.tire_scale)
+    _finite(m.eigenvalues)
+    k = m.least_damped
+    if args.json:
+        out.json({"eigenvalues": [[float(lam.real), float(lam.imag)] for lam in m.eigenvalues],
+                  "damping_ratio": [float(z) for z in m.damping_ratio],
+                  "damped_frequency_hz": [float(f) for f in m.damped_frequency_hz],
+                  "least_damped_mode": None if k is None else k + 1})
+        return 0
+    out.line(f"{v.name} at {_speed_text(args)}, tire scale {args.tire_scale:g} "
+             f"({'stable' if m.stable else 'UNSTABLE'}); modes by real part, * = least damped")
+    out.line(f"{'mode':>4} {'Re [1/s]':>10} {'Im [1/s]':>10} {'f_d [Hz]':>9} {'zeta [-]':>9}")
+    for row in m.table():
+        mark = " *" if k is not None and row["mode"] in (k + 1, k + 2) else ""
+        out.line(f"{row['mode']:>4} {row['real_per_s']:>10.4f} {row['imag_per_s']:>10.4f} "
+                 f"{row['damped_frequency_hz']:>9.4f} {row['damping_ratio']:>9.4f}{mark}")
+    return 0
+
+
+def _cmd_matrices(args, out: _Out) -> int:
+    from ..model.yaw_plane.equations import system_matrices
+    v = _vehicle(args)
+    which = args.units or ("thesis" if args.preset is not None else "si")
+    units = THESIS if which == "thesis" else SI
+    M, S = system_matrices(v, _speed_mps(args), args.tire_scale, units=units)
+    F = _load_vector(args, v, units) if args.load is not None else None
+    _finite(M, S, F)
+    label = "thesis units: lbf, in, s" if units is THESIS else "SI: N, m, kg, s"
+    if args.json:
+        doc = {"state": list(v.state_names), "units": label, "M": M.tolist(), "S": S.tolist()}
+        if F is not None:
+            doc["F"] = F.tolist()
+        out.json(doc)
+        return 0
+    out.line(f"state = {list(v.state_names)}  ({label})")
+    out.line("M =")
+    out.line(np.array2string(M, precision=6, max_line_width=200))
+    out.line("S =")
+    out.line(np.array2string(S, precision=6, max_line_width=200))
+    if F is not None:
+        out.line(f"F ({args.convention} convention) =")
+        out.line(np.array2string(F, precision=4, max_line_width=200))
+    return 0
+
+
+def _cmd_steady(args, out: _Out) -> int:
+    from ..analysis.steady import steady_state
+    from ..model.yaw_plane.outputs import rear_offsets
+    v = _vehicle(args)
+    F = _load_vector(args, v)
+    x = steady_state(v, _speed_mps(args), F, args.tire_scale)
+    n = v.n_units
+    y = rear_offsets(v, x[n + 1:])
+    _finite(x, y)
+    state = {name: float(value) for name, value in zip(v.state_names, x)}
+    ydoc = {f"y{k + 2}": float(val) for k, val in enumerate(y)}
+    if args.json:
+        out.json({"state": state, "y": ydoc})
+        return 0
+    out.line(f"steady state, {v.name} at {_speed_text(args)}, load on {args.load} ({args.convention} convention)")
+    for name, value in state.items():
+        unit = "m/s" if name == "v1" else "rad/s" if name.startswith("r") else "rad"
+        extra = f"  ({math.degrees(value):.4f} deg)" if name.startswith("theta") else ""
+        out.line(f"  {name:7s} {value: .6e} {unit}{extra}")
+    for name, value in ydoc.items():
+        out.line(f"  {name:7s} {value: .6e} m")
+    return 0

@@ -1,0 +1,192 @@
+"""The options the commands share and their parsing: the vehicle (a preset or a file), the
+speed, the load case, the residual sources; the one-line messages of a bad argument.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+import numpy as np
+
+from ..ranges import RANGES
+from ..units import MPS_PER_KPH, MPS_PER_MPH, SI
+
+
+class UsageError(Exception):
+    """A bad command-line argument; the message names it and what is valid (exit 2)."""
+
+
+def _number(text: str, what: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number ({what}), got {text!r}") from None
+
+
+def _ranged(key: str, factor: float = 1.0, unit: str | None = None, what: str = ""):
+    r = RANGES[key]
+
+    def conv(text: str) -> float:
+        value = _number(text, what or r.description)
+        if not r.contains(value / factor):
+            raise argparse.ArgumentTypeError(f"must be in {r.text(factor, unit)} ({what or r.description}), "
+                                             f"got {text}")
+        return value
+    return conv
+
+
+def _help_range(key: str, factor: float = 1.0, unit: str | None = None) -> str:
+    """The valid range of ``key`` for a help text (argparse formats help with %: a unit of % is doubled)."""
+    return RANGES[key].text(factor, unit).replace("%", "%%")
+
+
+# ---------------------------------------------------------------------------- inputs
+def _vehicle(args: argparse.Namespace):
+    from ..model.presets import PRESETS, load_preset
+    from ..model.vehicle import VehicleError
+    from ..model.vehicle_file import load_vehicle
+    if getattr(args, "preset", None) is not None:
+        if args.preset not in PRESETS:
+            raise UsageError(f"argument --preset: unknown preset {args.preset!r}; valid: {', '.join(PRESETS)}")
+        try:
+            return load_preset(args.preset, masses=getattr(args, "masses", "table"))
+        except ValueError as exc:
+            raise UsageError(f"argument --masses: {exc}") from None
+    if getattr(args, "masses", "table") != "table":
+        raise UsageError("argument --masses: only presets have unrounded masses")
+    try:
+        v = load_vehicle(args.vehicle)
+    except VehicleError as exc:
+        raise UsageError(f"argument --vehicle {args.vehicle}: {exc}") from None
+    from ..model.plausibility import plausibility_warnings
+    for line in plausibility_warnings(v):
+        print(f"lcv: warning: {_line(args.vehicle)}: {_line(line)}", file=sys.stderr)
+    return v
+
+
+def _speed_mps(args: argparse.Namespace) -> float:
+    if getattr(args, "speed_kph", None) is not None:
+        return args.speed_kph * MPS_PER_KPH
+    return args.speed_mph * MPS_PER_MPH
+
+
+def _speed_text(args: argparse.Namespace) -> str:
+    if getattr(args, "speed_kph", None) is not None:
+        return f"{args.speed_kph:g} km/h"
+    return f"{args.speed_mph:g} mph"
+
+
+def _load_units(args: argparse.Namespace, vehicle) -> list[str]:
+    from ..model.yaw_plane.loads import check_unit_names
+    names = [s.strip() for s in args.load.split(",")]
+    valid = ",".join(vehicle.unit_names)
+    if not names or any(not n for n in names):
+        raise UsageError(f"argument --load: expected a comma list of units from {valid}, got {args.load!r}")
+    try:
+        return check_unit_names(vehicle, names)
+    except KeyError as exc:
+        raise UsageError(f"argument --load: {exc.args[0]}") from None
+
+
+def _load_vector(args: argparse.Namespace, vehicle, units=SI) -> np.ndarray:
+    from ..model.yaw_plane.loads import load_vector, one_percent_rule
+    names = _load_units(args, vehicle)
+    try:
+        res = one_percent_rule(vehicle, names, t_sign=1.0)
+    except ValueError as exc:
+        raise UsageError(f"argument --load: {exc}") from None
+    return load_vector(vehicle, res, args.convention, units)
+
+
+def _sources(args: argparse.Namespace, vehicle):
+    """The residual sources of ``--residual``, ``--misalignment``, ``--crossfall-percent``."""
+    from ..model.yaw_plane.loads import ResidualLoads, ResidualSources
+    axles = vehicle.axle_names
+    P, T, eps = {}, {}, {}
+
+    def axle(option, name):
+        if name not in axles:
+            raise UsageError(f"argument {option}: unknown axle {name!r} of {vehicle.name}; valid: {', '.join(axles)}")
+        return name
+
+    for item in getattr(args, "residual", []) or []:
+        name, sep, value = item.partition("=")
+        parts = value.split(",")
+        if not sep or len(parts) != 2:
+            raise UsageError(f"argument --residual: expected AXLE=P,T (N, N*m), got {item!r}")
+        a = axle("--residual", name.strip())
+        if a in P:
+            raise UsageError(f"argument --residual: axle {a!r} is given twice")
+        for sym, text, key in (("P", parts[0], "residual_force"), ("T", parts[1], "residual_moment")):
+            try:
+                val = float(text)
+            except ValueError:
+                raise UsageError(f"argument --residual: {sym} of axle {a} must be a number, got {text!r}") from None
+            if not RANGES[key].contains(val):
+                raise UsageError(f"argument --residual: {sym} of axle {a} must be in {RANGES[key].text()}, got {text}")
+            (P if sym == "P" else T)[a] = val
+    for group in getattr(args, "misalignment", []) or []:
+        for item in group.split(","):
+            name, sep, value = item.partition("=")
+            if not sep:
+                raise UsageError(f"argument --misalignment: expected AXLE=RAD, got {item!r}")
+            a = axle("--misalignment", name.strip())
+            if a in eps:
+                raise UsageError(f"argument --misalignment: axle {a!r} is given twice")
+            try:
+                val = float(value)
+            except ValueError:
+                raise UsageError(f"argument --misalignment: the angle of axle {a} must be a number, got {value!r}") \
+                    from None
+            if not RANGES["misalignment"].contains(val):
+                raise UsageError(f"argument --misalignment: the angle of axle {a} must be in "
+                                 f"{RANGES['misalignment'].text()}, got {value}")
+            eps[a] = val
+    if getattr(args, "tires", None):
+        from ..tracking.tires import TrackingError, axle_residuals, read_mounted_tires
+        try:
+            loads = axle_residuals(vehicle, read_mounted_tires(args.tires))
+        except TrackingError as exc:
+            raise UsageError(f"argument --tires: {exc}") from None
+        for a, val in loads.P_N.items():
+            P[a] = P.get(a, 0.0) + val
+        for a, val in loads.T_Nm.items():
+            T[a] = T.get(a, 0.0) + val
+    crossfall = getattr(args, "crossfall_percent", None) or 0.0
+    return ResidualSources(ResidualLoads(P, T), eps, crossfall)
+
+
+def _parse_speeds(args: argparse.Namespace) -> tuple[list[float], str]:
+    """Speeds [m/s] of ``--speed-kph``/``--speed-mph`` (one, or START:STOP:STEP) and the unit."""
+    text, unit, factor = (args.speed_kph, "km/h", MPS_PER_KPH) if args.speed_kph is not None else \
+        (args.speed_mph, "mph", MPS_PER_MPH)
+    option = "--speed-kph" if unit == "km/h" else "--speed-mph"
+    r = RANGES["speed"]
+    parts = text.split(":")
+    try:
+        nums = [float(x) for x in parts]
+    except ValueError:
+        raise UsageError(f"argument {option}: expected a number or START:STOP:STEP, got {text!r}") from None
+    if len(nums) == 1:
+        values = nums
+    elif len(nums) == 3:
+        lo, hi, step = nums
+        if not (math.isfinite(step) and step > 0 and hi >= lo):
+            raise UsageError(f"argument {option}: START:STOP:STEP needs STOP >= START and STEP > 0, got {text!r}")
+        count = int(math.floor((hi - lo) / step + 1e-9)) + 1
+        if count > 1000:
+            raise UsageError(f"argument {option}: {count} speeds; at most 1000")
+        values = [lo + k * step for k in range(count)]
+    else:
+        raise UsageError(f"argument {option}: expected a number or START:STOP:STEP, got {text!r}")
+    for val in values:
+        if not r.contains(val * factor):
+            raise UsageError(f"argument {option}: must be in {r.text(1 / factor, unit)}, got {val:g}")
+    return [val * factor for val in values], unit
+
+
+def _line(text) -> str:
+    """``text`` as one line of plain text: every character that is not printable (a newline, an
+    ESC that would drive the terminal) escaped, so a message quoting a user's file is one line."""
+    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(text))

@@ -1,0 +1,1 @@
+"""The field's measures, one family per module, each scalar and batched, registered once."""

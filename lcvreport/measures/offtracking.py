@@ -1,0 +1,200 @@
+"""High-speed offtracking (``docs/measures.md``): the transient one of the lane change and
+the steady one of the 393 m turn.
+
+========================  ==========================================================
+``hsto_m``                high-speed transient offtracking in ``lane-change:0.15g:0.4``
+``ra_lane_change``        max|a_N| / max|a_s| in that lane change
+``hsso_m``                high-speed steady-state offtracking in a 393 m turn
+``steady_turn_delta_rad`` the steer angle of that turn
+========================  ==========================================================
+
+Each function takes the vehicle and the speed and returns a small named result; the
+null cases carry the reason (``why``).
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> t = steady_turn(load_preset("aucnat"), 24.4444)
+>>> round(t.hsso_m, 3)
+0.551
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.exact import ManoeuvreError, ManoeuvreResponse, check_lane_change_steer, response
+from ..analysis.steady import steady_with_yaw_rate
+from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
+from ..model.vehicle import Vehicle
+from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.outputs import point_lateral_map
+
+#: the lane change of HSTO: A0 [g], F [Hz], time after it [s]
+LANE_CHANGE = (0.15, 0.4)
+
+
+LANE_CHANGE_TAIL_S = 8.0
+
+
+#: the steady turn of HSSO: radius of the tractor's yaw rate u/R [m] (0.2 g at 100 km/h)
+HSSO_RADIUS_M = 393.0
+
+
+#: output step of the manoeuvres [s] (the YDC window is long and its extrema are located
+#: between samples by Hermite interpolation, whose error goes as the step to the 4th power)
+DT_S = 0.002
+
+
+@dataclass(frozen=True)
+class LaneChangeMeasures:
+    """HSTO and the lane-change RA (SPEC section 12)."""
+
+    hsto_m: float
+    ra_lane_change: float
+    final_offset_m: float
+    response: ManoeuvreResponse
+    rear_axle: str
+    steered_axle: str
+
+
+def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
+                         accel_g: float = LANE_CHANGE[0], f_hz: float = LANE_CHANGE[1]) -> LaneChangeMeasures:
+    """The path-following lane change ``lane-change:0.15g:0.4``: the largest overshoot of
+    the last unit's rearmost axle beyond the steered axle's final offset A0/(2 pi F^2)
+    over 0 <= t <= 1/F + 8 s (0 if none), and max|a_N| / max|a_s|.
+
+    Raises
+    ------
+    ManoeuvreError
+        No steered axle, an unstable inverse system, or a steer beyond [-1, 1] rad.
+    """
+    steer = lane_change(accel_g * G_MPS2, f_hz)
+    t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
+    r = response(vehicle, speed_mps, steer, t_end, DT_S, tire_scale=tire_scale)
+    offset = lane_change_offset_m(steer)
+    rear = vehicle.units[-1].rearmost_axle.name
+    steered = max(vehicle.steered_axles, key=lambda a: a.x_m).name
+    sign = 1.0 if offset >= 0 else -1.0
+    (_t, Y), (_ta, a_n), (_ts, a_s), (_td, d) = r.extrema_many([f"Y_{rear}", f"ay{vehicle.n_units}", "a_steer",
+                                                                 "delta"])
+    check_lane_change_steer(r, float(np.abs(d).max()))
+    hsto = max(0.0, float(np.max(sign * (Y - offset))))
+    ra = float(np.abs(a_n).max()) / float(np.abs(a_s).max())
+    return LaneChangeMeasures(hsto, float(ra), offset, r, rear, steered)
+
+
+@dataclass(frozen=True)
+class SteadyTurn:
+    """The steady turn of HSSO (SPEC section 12, as corrected 2026-12).
+
+    Attributes
+    ----------
+    hsso_m : float
+        Path radius of the last unit's rearmost axle minus that of the frontmost steered axle [m]
+        (positive: the rear tracks outside).
+    delta_rad : float
+        The steer that holds the turn [rad].
+    radius_m : float
+        R: the tractor's yaw rate is u/R [m].
+    state : numpy.ndarray
+        The steady state x.
+    path_radius_m : dict
+        Axle name -> the radius of its centre's path about the turn centre [m].
+    sideslip_rad : numpy.ndarray, shape (N,)
+        beta_i = v_i/u of every unit's CG.
+    axis_distance_m : numpy.ndarray, shape (N,)
+        d_i: the distance from the turn centre to every unit's axis line [m] (d_1 = R).
+    """
+
+    hsso_m: float
+    delta_rad: float
+    radius_m: float
+    state: np.ndarray
+    path_radius_m: dict
+    sideslip_rad: np.ndarray = None
+    axis_distance_m: np.ndarray = None
+
+
+def chain_on_circle(vehicle: Vehicle, beta, radius_m: float) -> np.ndarray:
+    r"""Distances d_i [m] from the turn centre O to every unit's axis line, for units turning
+    about one centre with CG sideslips ``beta`` (shape (..., N)): in unit i's frame O lies at
+    (-beta_i d_i, d_i); d_1 = R; the coupling k (x = rear_coupling_m on unit k, front_coupling_m
+    on unit k+1) is one point, so it has one radius,
+
+    .. math:: (x_{r,k} + \beta_k d_k)^2 + d_k^2 = (x_{f,k+1} + \beta_{k+1} d_{k+1})^2 + d_{k+1}^2,
+
+    which gives d_(k+1) (the positive root).  Broadcasts over a leading axis (variants).
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> import numpy as np
+    >>> v = load_preset("tractor_semitrailer")
+    >>> d = chain_on_circle(v, np.zeros(2), 393.0)      # no sideslip: the fifth wheel has one radius
+    >>> xr, xf = v.units[0].rear_coupling_m, v.units[1].front_coupling_m
+    >>> bool(abs(np.hypot(xr, d[0]) - np.hypot(xf, d[1])) < 1e-9)
+    True
+    """
+    beta = np.asarray(beta, dtype=float)
+    d = np.empty(beta.shape)
+    d[..., 0] = radius_m
+    for k in range(vehicle.n_units - 1):
+        xr, xf = vehicle.units[k].rear_coupling_m, vehicle.units[k + 1].front_coupling_m
+        rho2 = (xr + beta[..., k] * d[..., k]) ** 2 + d[..., k] ** 2
+        b = beta[..., k + 1]
+        d[..., k + 1] = (-xf * b + np.sqrt((1.0 + b * b) * rho2 - xf * xf)) / (1.0 + b * b)
+    return d
+
+
+def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
+                radius_m: float = HSSO_RADIUS_M) -> SteadyTurn:
+    """The steady turn with the tractor's yaw rate u/R (SPEC section 12, corrected 2026-12): the
+    steady state of ``M x' = S x + b delta`` with r1 = u/R gives every unit's CG sideslip
+    beta_i = v_i/u; every unit turns at Omega = u/R about one centre O, the units' geometry
+    chained through their shared couplings (:func:`chain_on_circle`); a point at x on unit i runs
+    on R_P = sqrt((x + beta_i d_i)^2 + d_i^2).  hsso_m = R_P of the last unit's rearmost axle
+    minus R_P of the frontmost steered axle (positive: the rear tracks outside).  As u -> 0 it is
+    the kinematic offtracking -(sum L_i^2 - sum k_i^2 - e_N^2) / (2R) to first order in 1/R.
+
+    Raises
+    ------
+    ManoeuvreError
+        No steered axle.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> t = steady_turn(load_preset("tractor_semitrailer"), 0.5)      # walking pace: kinematic
+    >>> bool(-1.0 < t.hsso_m < 0.0)                                  # the trailer tracks inside
+    True
+    """
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    if not vehicle.steered_axles:
+        raise ManoeuvreError(f"{vehicle.name} has no steered axle: no steer holds a turn")
+    co = system_coefficients(vehicle)
+    u = float(speed_mps)
+    omega = u / radius_m
+    x, delta = steady_with_yaw_rate(vehicle, u, np.zeros(vehicle.n_states), omega, tire_scale)
+    beta = (co.velocity_map(u) @ x) / u             # CG sideslip of every unit
+    d = chain_on_circle(vehicle, beta, radius_m)
+
+    def radius(unit, xp):
+        return math.hypot(xp + beta[unit] * d[unit], d[unit])
+
+    steered = max(vehicle.steered_axles, key=lambda a: a.x_m)
+    rear = vehicle.units[-1].rearmost_axle
+    paths = {a.name: radius(i, a.x_m) for i, a in zip(vehicle.axle_units, vehicle.axles)}
+    hsso = radius(vehicle.n_units - 1, rear.x_m) - radius(0, steered.x_m)
+    return SteadyTurn(float(hsso), delta, float(radius_m), x, paths, beta, d)
+
+
+def point_path(vehicle: Vehicle, response: ManoeuvreResponse, unit: int, x_m: float) -> np.ndarray:
+    """Global lateral position [m] of any point of any unit in a manoeuvre (first order)."""
+    c = point_lateral_map(vehicle, unit, x_m)
+    Theta = np.column_stack([response[f"Theta{k + 2}"] for k in range(vehicle.n_units - 1)]) \
+        if vehicle.n_units > 1 else np.zeros((response.time.size, 0))
+    return c[0] * response["psi1"] + c[1] * response["Y1"] + Theta @ c[2:]

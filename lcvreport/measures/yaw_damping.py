@@ -1,0 +1,146 @@
+"""The yaw damping coefficient (``docs/measures.md#yaw-damping-coefficient``): the ratio
+method on the free decay of every articulation angle after a steer pulse of 0.01 rad for
+0.5 s, over 40 s; the coefficient is the smallest over the joints.  Each joint's peak-to-peak
+amplitudes are taken from its largest on, those of at least 5 % of it, the first six; a joint
+with fewer than two decays faster than 20:1 per half cycle (zeta >= 0.6901), and when every
+joint is so the coefficient is None with that lower bound.
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> round(yaw_damping_coefficient(load_preset("aucnat"), 24.4444).value, 3)
+0.217
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.exact import ManoeuvreResponse, response
+from ..manoeuvres.steer import pulse
+from ..model.vehicle import Vehicle
+
+#: the YDC pulse: amplitude [rad], duration [s]; the window after it [s]
+YDC_PULSE = (0.01, 0.5)
+
+
+YDC_WINDOW_S = 40.0
+
+
+#: amplitudes kept: at least this fraction of the joint's largest, the first this many
+YDC_MIN_FRACTION = 0.05
+
+
+YDC_MAX_AMPLITUDES = 6
+
+
+#: a joint with fewer than two kept amplitudes decays faster than 1/YDC_MIN_FRACTION per half
+#: cycle: its zeta is at least this (ln 20 / sqrt(pi^2 + ln^2 20) = 0.6901), the YDC's lower bound
+#: when every joint is so (SPEC 12)
+YDC_HEAVY_ZETA = math.log(1.0 / YDC_MIN_FRACTION) / math.sqrt(math.pi ** 2 + math.log(1.0 / YDC_MIN_FRACTION) ** 2)
+
+
+YDC_DT_S = 0.005
+
+
+@dataclass(frozen=True)
+class YawDamping:
+    """The ratio-method yaw damping of a pulse steer (SPEC section 12).
+
+    Attributes
+    ----------
+    value : float or None
+        The smallest per-joint value (None if no joint has two amplitudes).
+    per_joint : list of (float or None)
+        Each joint's mean ratio damping.
+    amplitudes : list of numpy.ndarray
+        The kept peak-to-peak amplitudes P_i of each joint [rad].
+    extrema : list of (numpy.ndarray, numpy.ndarray)
+        Times [s] and values [rad] of each joint's extrema after the pulse.
+    modal_least_damping_ratio : float or None
+        The modal zeta_min beside it (several modes of near frequency make the ratio
+        method read low).
+    response : ManoeuvreResponse
+    why : str
+        Why ``value`` is None.
+    lower_bound : float or None
+        When every joint is heavily damped (fewer than two kept amplitudes: a decay faster
+        than x20 per half cycle), the bound ``YDC_HEAVY_ZETA`` = 0.6901 its value is at least;
+        None otherwise.
+    """
+
+    value: float | None
+    per_joint: list
+    amplitudes: list
+    extrema: list
+    modal_least_damping_ratio: float | None
+    response: ManoeuvreResponse
+    why: str = ""
+    lower_bound: float | None = None
+
+
+def ratio_damping(extrema_values) -> tuple[float | None, np.ndarray]:
+    """The ratio method on a signal's successive extrema (time order): the peak-to-peak
+    amplitudes P_i = |A_(i+1) - A_i|; the free decay starts at the largest (the amplitudes
+    before it are the forced response); from it on, those >= 5 % of it (a smaller one is
+    skipped, later ones still count), the first six; the mean over consecutive pairs of kept
+    amplitudes of zeta = d / sqrt(pi^2 + d^2), d = ln(P_i/P_(i+1)); None when fewer than two are
+    kept (SPEC 12, corrected 2026-12).  For one damped mode ``exp(sigma t) sin(omega t)`` it is
+    exactly -sigma / |lambda|.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> lam = -0.3 + 2.0j                     # extrema of exp(-0.3 t) sin(2 t + phi) are pi/2 apart
+    >>> A = np.exp(lam.real * np.pi / 2 * np.arange(8)) * (-1.0) ** np.arange(8)
+    >>> round(ratio_damping(A)[0], 12) == round(-lam.real / abs(lam), 12)
+    True
+    """
+    v = np.asarray(extrema_values, dtype=float)
+    P = np.abs(np.diff(v))
+    if P.size:
+        P = P[int(np.argmax(P)):]                  # the free decay starts at the largest amplitude
+        P = P[P >= YDC_MIN_FRACTION * P[0]][:YDC_MAX_AMPLITUDES]
+    if P.size < 2:
+        return None, P
+    d = np.log(P[:-1] / P[1:])
+    return float(np.mean(d / np.sqrt(np.pi ** 2 + d ** 2))), P
+
+
+def yaw_damping_coefficient(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> YawDamping:
+    """PBS-style yaw damping: the pulse ``pulse:0.01:0.5``; for each joint the extrema of
+    its articulation angle from the end of the pulse to 40 s after (zeros of theta',
+    located on the continuous response), their peak-to-peak amplitudes P_i = |A_(i+1) -
+    A_i|, the first six of those >= 5 % of the joint's largest; each consecutive pair
+    gives zeta = d / sqrt(pi^2 + d^2), d = ln(P_i / P_(i+1)); a joint's value is the mean
+    of its pairs; the coefficient the smallest over joints with two amplitudes or more.
+    """
+    from .stability import least_damping
+    return _yaw_damping(vehicle, speed_mps, tire_scale, least_damping(vehicle, speed_mps, tire_scale)[0])
+
+
+def _yaw_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float, zeta_modal: float | None) -> YawDamping:
+    """:func:`yaw_damping_coefficient` with the modal least damping ratio already known."""
+    A, D = YDC_PULSE
+    steer = pulse(A, D)
+    t_end = round((D + YDC_WINDOW_S) / YDC_DT_S) * YDC_DT_S
+    r = response(vehicle, speed_mps, steer, t_end, YDC_DT_S, tire_scale=tire_scale)
+    if vehicle.n_units < 2:
+        return YawDamping(None, [], [], [], zeta_modal, r, "no joint: a single unit has no articulation angle")
+    per_joint, amps, ext = [], [], []
+    for t, v in r.extrema_many(vehicle.state_names[vehicle.n_units + 1:], D, D + YDC_WINDOW_S):
+        inner = (t > D + 1e-12) & (t < D + YDC_WINDOW_S - 1e-12)     # the window's ends are not extrema
+        t, v = t[inner], v[inner]
+        ext.append((t, v))
+        zeta, P = ratio_damping(v)
+        amps.append(P)
+        per_joint.append(zeta)
+    defined = [z for z in per_joint if z is not None]
+    if not defined:
+        return YawDamping(None, per_joint, amps, ext, zeta_modal, r,
+                          f"heavily damped: no joint has two peak-to-peak amplitudes of at least 5 % of its "
+                          f"largest after the pulse (a decay faster than x20 per half cycle), so YDC >= "
+                          f"{YDC_HEAVY_ZETA:.4f}", YDC_HEAVY_ZETA)
+    return YawDamping(min(defined), per_joint, amps, ext, zeta_modal, r)

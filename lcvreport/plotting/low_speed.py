@@ -1,0 +1,83 @@
+"""The low-speed turn seen from above: outlines, the envelope the turn computed, the wheel
+paths and the measures.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .style import PAGE_WIDTH_IN, PALETTE, SMALL_PT, new_figure
+
+
+def fig_swept_path(turn, title: str, outlines_every_m: float = 2.0) -> Figure:
+    """The low-speed turn seen from above, to scale (SPEC section 16): every unit's outline
+    every ``outlines_every_m`` of path, the swept region's envelope within the turn, the
+    paths of the outside steer wheel and of the last unit's inside rear wheel, the arc's
+    centre and the measures marked [m].  ``turn`` is a
+    :class:`lcvreport.measures.low_speed.LowSpeedTurn`."""
+    from matplotlib.patches import Polygon as _Poly
+
+    from ..model.body import corners
+    v, run = turn.vehicle, turn.run
+    path = run.path
+    C = path.centre
+    s_draw_end = min(path.s_end, path.arc_end_s + 1.2 * turn.overall_length_m)
+    fig, ax = new_figure(PAGE_WIDTH_IN, 5.6)
+    # outlines
+    s_out = np.arange(0.0, s_draw_end + 1e-9, outlines_every_m)
+    for k in range(v.n_units):
+        cx, cy = corners(v, k)
+        pts = run.unit_points(s_out, k, cx, cy)
+        for j, poly in enumerate(pts):
+            ax.add_patch(_Poly(poly, closed=True, facecolor="none", edgecolor=PALETTE[k % len(PALETTE)],
+                               lw=0.35, alpha=0.55, zorder=1))
+    # the vehicle at the start, filled
+    for k in range(v.n_units):
+        cx, cy = corners(v, k)
+        ax.add_patch(_Poly(run.unit_points([0.0], k, cx, cy)[0], closed=True, facecolor=PALETTE[k % len(PALETTE)],
+                           edgecolor="black", lw=0.5, alpha=0.35, zorder=2,
+                           label="the combination before the turn" if k == 0 else None))
+    # the envelope of the swept region within the turn (computed by the turn, drawn here)
+    mid, r_min, r_max = turn.envelope()
+    env = lambda rr: np.stack([C[0] + rr * np.sin(mid), C[1] - rr * np.cos(mid)], axis=1)  # noqa: E731
+    ax.plot(*env(r_max).T, color="black", lw=1.4, zorder=6, label="envelope of the swept region (in the turn)")
+    ax.plot(*env(r_min).T, color="black", lw=1.4, zorder=6)
+    angle = math.radians(min(turn.angle_deg, 360.0))
+    # the two wheel paths
+    steer = max((a for a in v.units[0].axles if a.steered), key=lambda a: a.x_m)
+    s_path = np.linspace(-0.3 * turn.overall_length_m, s_draw_end, 800)
+    s_pos = np.clip(s_path, 0.0, None)
+    ow = run.unit_points(s_pos, 0, [steer.x_m], [-steer.track_width_m / 2])[:, 0]
+    ow[s_path < 0, 0] += s_path[s_path < 0]
+    ax.plot(*ow.T, color=PALETTE[1], lw=1.2, zorder=5, label=f"outside wheel of axle {steer.name} (R = "
+            f"{turn.radius_m:g} m)")
+    last = v.n_units - 1
+    rear = v.units[last].rearmost_axle
+    iw = run.unit_points(s_pos, last, [rear.x_m], [rear.track_width_m / 2])[:, 0]
+    iw[s_path < 0, 0] += s_path[s_path < 0]
+    ax.plot(*iw.T, color=PALETTE[2], lw=1.2, zorder=5, label=f"inside wheel of axle {rear.name}")
+    ax.plot(*C, "+", color="black", ms=8, zorder=6)
+    # measures: the swept width along the bisector of the turn, the offtracking in the text
+    w = turn.where
+    if turn.lssp_m is not None:
+        b = 0.5 * angle
+        u_dir = np.array([math.sin(b), -math.cos(b)])
+        p_in, p_out = C + w["inner_radius_m"] * u_dir, C + w["outer_radius_m"] * u_dir
+        ax.annotate("", p_out, p_in, arrowprops=dict(arrowstyle="<->", lw=0.9, color="black"), zorder=7)
+        ax.text(*(0.5 * (p_in + p_out)), f"  swept width {turn.lssp_m:.2f} m", fontsize=SMALL_PT, zorder=7,
+                rotation=math.degrees(b) - 90 if -90 < math.degrees(b) - 90 < 90 else 0)
+    ax.set_aspect("equal")
+    ax.set_xlabel("X [m]")
+    ax.set_ylabel("Y [m]")
+    ax.grid(True, lw=0.3)
+    ax.autoscale_view()
+    ax.legend(fontsize=SMALL_PT, loc="upper left")
+    def m(value, digits=2):
+        return "not computed" if value is None else f"{value:.{digits}f} m"
+    ax.set_title(f"{title}\nswept width {m(turn.lssp_m)}, low-speed offtracking {m(turn.low_speed_offtracking_m)}, "
+                 f"largest tail swing {m(turn.max_tail_swing_m, 3)}, frontal swing {m(turn.frontal_swing_m)}",
+                 fontsize=8)
+    fig.lcv_data = turn.rows()
+    return fig

@@ -1,0 +1,1 @@
+"""Straight-line tracking over a tire population: tire slots and files, statistics, the mounting plan."""
