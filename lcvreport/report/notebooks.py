@@ -250,9 +250,24 @@ def notebook_dir() -> Path:
     return Path(str(resources.files("lcvreport.notebooks")))
 
 
+#: the loggers of the notebook machinery: silent while a report is built (a failure is one
+#: :class:`ReportError` naming the notebook and the cell; an interruption one line)
+CLIENT_LOGGERS = ("traitlets", "nbclient", "papermill", "jupyter_client")
+
+
+def silence_client_loggers() -> None:
+    """Nothing from the notebook client reaches the terminal.  Its event-loop thread reports a
+    kernel that ends under it (a Ctrl-C during the kernel's start, which the kernel cannot yet
+    catch) as an error, possibly before the main thread has taken the interruption."""
+    import logging
+    for name in CLIENT_LOGGERS:
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+
+
 def execute(stem: str, out_dir: Path, parameters: dict, source_dir: Path | None = None) -> Path:
     """Check the parameters, then execute ``<source_dir>/<stem>.ipynb`` with papermill into ``out_dir``."""
     import papermill as pm
+    silence_client_loggers()
     if stem in SPECS:
         check_notebook_parameters(stem, parameters)
     src = (source_dir or notebook_dir()) / f"{stem}.ipynb"

@@ -7,7 +7,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from .notebooks import ReportError, _alive, _stop_kernels
+from .notebooks import ReportError, _alive, _stop_kernels, silence_client_loggers
 
 
 def _prepare(out_dir: Path) -> tuple[Path, Path]:
@@ -89,9 +89,7 @@ def _discard(staged: Path, interrupted: bool = False) -> None:
     cell the kernel was running; the loggers it reports through are silenced first, so that the
     kernel's end is not reported as an error (the interruption is the one line)."""
     if interrupted:
-        import logging
-        for name in ("traitlets", "nbclient", "papermill", "jupyter_client"):
-            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+        silence_client_loggers()
     _stop_kernels()
     shutil.rmtree(staged, ignore_errors=True)
 
