@@ -17,13 +17,9 @@ PACKAGE = Path(lcvreport.__file__).resolve().parent
 #: the layers, lowest first: a module may import its own folder and the ones before it
 LAYERS = ["units", "ranges", "util", "model", "manoeuvres", "plotting", "analysis", "measures", "tracking", "thesis",
           "fmu", "study", "report", "cli", "_entry"]
-#: imports of a higher layer allowed inside a function only (never at import time)
-LAZY_UPWARD = {
-    ("analysis.batch", "measures.amplification"), ("analysis.batch", "measures.offtracking"),
-    ("analysis.batch", "measures.registry"), ("analysis.batch", "measures.stability"),
-    ("analysis.batch", "measures.yaw_damping"), ("plotting.study", "measures.registry"),
-    ("model.presets", "thesis.vehicles"),
-}
+#: imports of a higher layer allowed inside a function only (never at import time): none.  A
+#: result that plots itself imports ``plotting`` downward, inside its ``.plot()``.
+LAZY_UPWARD: set = set()
 
 
 def _modules() -> dict[str, Path]:
@@ -160,3 +156,82 @@ def test_one_source_for_joint_letters_and_ranges():
             if literal in text:
                 offenders.append((module, literal))
     assert not offenders, offenders
+
+
+def _graph() -> dict[str, set[str]]:
+    """module -> the package modules it imports (at import time or inside a function)."""
+    graph = {}
+    for module, path in MODULES.items():
+        if not module:
+            continue
+        targets = set()
+        for target, _nested in _imports(path, module):
+            while target and target not in MODULES:
+                target = target.rpartition(".")[0]       # ``from .x import name``: the module x
+            if target and target != module:
+                targets.add(target)
+        graph[module] = targets
+    return graph
+
+
+def test_no_import_cycle():
+    """No module reaches itself through imports, lazy ones included (Tarjan's strongly connected
+    components: every one of size 1)."""
+    graph = _graph()
+    index, low, stack, on, cycles = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                cycles.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    assert not cycles, cycles
+
+
+def test_no_two_folders_import_each_other():
+    graph = _graph()
+    edges = {(_layer(m), _layer(t)) for m, ts in graph.items() for t in ts if _layer(m) != _layer(t)}
+    pairs = sorted({tuple(sorted(e)) for e in edges if (e[1], e[0]) in edges})
+    assert not pairs, pairs
+
+
+def test_the_upward_allowance_is_empty():
+    assert LAZY_UPWARD == set()
+
+
+def test_no_module_is_longer_than_700_lines():
+    long = {m: n for m, p in MODULES.items() if (n := len(p.read_text(encoding="utf-8").splitlines())) > 700}
+    assert not long, long
+
+
+def test_the_cycle_check_finds_a_cycle(tmp_path):
+    """The check itself: two modules that import each other lazily are a cycle."""
+    global MODULES
+    saved = MODULES
+    (tmp_path / "a.py").write_text("def f():\n    from .b import g\n")
+    (tmp_path / "b.py").write_text("def g():\n    from .a import f\n")
+    try:
+        MODULES = {"analysis.a": tmp_path / "a.py", "analysis.b": tmp_path / "b.py"}
+        with pytest.raises(AssertionError):
+            test_no_import_cycle()
+    finally:
+        MODULES = saved

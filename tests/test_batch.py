@@ -7,6 +7,11 @@ import pytest
 
 from lcvreport import load_preset, load_vehicle
 from lcvreport.analysis.batch import AXLE_PARAMETERS, UNIT_PARAMETERS, BatchError, VariantBatch, _nominal, _with
+from lcvreport.measures.amplification import ra_peak_batched, single_sine_batched
+from lcvreport.measures.measure_set import batch_measures
+from lcvreport.measures.offtracking import lane_change_batched, steady_turn_batched
+from lcvreport.measures.stability import critical_speed_batched, least_damping_batched
+from lcvreport.measures.yaw_damping import yaw_damping_batched
 from lcvreport.measures.stability import least_damping
 from lcvreport.analysis.modes import eigenvalues, state_matrix
 
@@ -32,7 +37,7 @@ def test_batched_measures_equal_one_variant_calls(source):
     batch = VariantBatch(v, values)
     u = 24.0
     A = batch.state_matrix(u)
-    zeta, f_hz = batch.least_damping(u)
+    zeta, f_hz = least_damping_batched(batch, u)
     top = batch.max_real(u)
     for i in range(B):
         vi = _variant(v, values, i)
@@ -64,7 +69,7 @@ def test_batched_critical_speed_equals_the_one_variant_algorithm(tire_scale):
     rng = np.random.default_rng(14)
     B = 16
     values = {n: _nominal(v, n) * rng.uniform(0.6, 1.4, B) for n in names}
-    got = VariantBatch(v, values).critical_speed(tire_scale=tire_scale)
+    got = critical_speed_batched(VariantBatch(v, values), tire_scale=tire_scale)
     ref = []
     for i in range(B):
         vi = _variant(v, values, i)
@@ -115,7 +120,7 @@ def test_batched_steady_turn_equals_hsso():
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(11)
     values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 6) for n in names}
-    hsso, delta = VariantBatch(v, values).steady_turn(24.0)
+    hsso, delta = steady_turn_batched(VariantBatch(v, values), 24.0)
     for i in range(6):
         vi = _variant(v, values, i)
         t = steady_turn(vi, 24.0)
@@ -131,7 +136,7 @@ def test_batched_ra_peak_equals_the_one_variant_peak():
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(2)
     values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 6) for n in names}
-    peak, where = VariantBatch(v, values).ra_peak(24.0)
+    peak, where = ra_peak_batched(VariantBatch(v, values), 24.0)
     for i in range(6):
         vi = _variant(v, values, i)
         p = ra_peak(vi, 24.0)
@@ -142,7 +147,7 @@ def test_the_measures_table_has_the_measure_set_numbers():
     from lcvreport import measure_set
     v = load_preset("tractor_semitrailer")
     values = {"trailer1.mass_kg": _nominal(v, "trailer1.mass_kg") * np.array([0.9, 1.0, 1.1])}
-    table = VariantBatch(v, values).measures(24.0)
+    table = batch_measures(VariantBatch(v, values), 24.0)
     assert list(table["case_id"]) == [0, 1, 2] and "trailer1.mass_kg" in table
     m = measure_set(v, 24.0).to_dict()                              # the middle case is the vehicle itself
     for key in ("least_damping_ratio", "least_damped_frequency_hz", "ra_frequency", "ra_peak", "hsso_m",
@@ -160,12 +165,12 @@ def test_ra_peak_does_not_depend_on_the_batch_or_the_scan(monkeypatch):
     names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
     rng = np.random.default_rng(5)
     values = {n: _nominal(v, n) * rng.uniform(0.7, 1.3, 9) for n in names}
-    whole = VariantBatch(v, values).ra_peak(22.0)
+    whole = ra_peak_batched(VariantBatch(v, values), 22.0)
     for part in (slice(0, 1), slice(2, 7), slice(8, 9)):
-        sub = VariantBatch(v, {n: a[part] for n, a in values.items()}).ra_peak(22.0)
+        sub = ra_peak_batched(VariantBatch(v, {n: a[part] for n, a in values.items()}), 22.0)
         assert np.array_equal(sub[0], whole[0][part]) and np.array_equal(sub[1], whole[1][part])
     monkeypatch.setattr(batch_module, "SCAN_COND_MAX", 0.0)             # every variant: the exact scan
-    exact = VariantBatch(v, values).ra_peak(22.0)
+    exact = ra_peak_batched(VariantBatch(v, values), 22.0)
     assert np.array_equal(exact[0], whole[0]) and np.array_equal(exact[1], whole[1])
 
 
@@ -180,7 +185,7 @@ def test_batched_single_sine_is_the_one_variant_single_sine(preset, speed):
     rng = np.random.default_rng(9)
     B = 70                                     # two groups
     values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, B) for n in names}
-    ra = VariantBatch(v, values).single_sine(speed)
+    ra = single_sine_batched(VariantBatch(v, values), speed)
     for i in (0, 1, 63, 64, 69):
         ref = single_sine(_variant(v, values, i), speed).rearward_amplification
         assert ra[i] == pytest.approx(ref, rel=1e-12), i
@@ -198,7 +203,7 @@ def test_batched_yaw_damping_is_the_one_variant_coefficient(preset, speed):
     rng = np.random.default_rng(10)
     B = 66
     values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, B) for n in names}
-    ydc = VariantBatch(v, values).yaw_damping(speed)
+    ydc = yaw_damping_batched(VariantBatch(v, values), speed)
     for i in (0, 7, 63, 64, 65):
         ref = yaw_damping_coefficient(_variant(v, values, i), speed).value
         if ref is None:
@@ -217,7 +222,7 @@ def test_batched_lane_change_is_the_one_variant_lane_change(preset, speed):
     rng = np.random.default_rng(11)
     B = 66
     values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, B) for n in names}
-    hsto, ra = VariantBatch(v, values).lane_change(speed)
+    hsto, ra = lane_change_batched(VariantBatch(v, values), speed)
     for i in (0, 5, 63, 64, 65):
         ref = lane_change_measures(_variant(v, values, i), speed)
         assert hsto[i] == pytest.approx(ref.hsto_m, rel=1e-12, abs=1e-12), i
@@ -232,16 +237,16 @@ def test_a_variant_with_an_unstable_inverse_system_has_no_lane_change():
     v = load_preset("legal_max")
     name = f"{v.units[0].name}.yaw_inertia_kg_m2"
     values = {name: _nominal(v, name) * np.array([1.0, 1.0])}
-    hsto, ra = VariantBatch(v, values).lane_change(60.0)
+    hsto, ra = lane_change_batched(VariantBatch(v, values), 60.0)
     with pytest.raises(ManoeuvreError, match="unstable"):
         lane_change_measures(v, 60.0)
     assert np.isnan(hsto).all() and np.isnan(ra).all()
-    hsto, _ra = VariantBatch(v, values).lane_change(20.0)
+    hsto, _ra = lane_change_batched(VariantBatch(v, values), 20.0)
     assert np.isfinite(hsto).all()
 
 
 def test_the_grouped_ratio_method_equals_the_one_signal_method():
-    from lcvreport.analysis.batch import ratio_damping_groups
+    from lcvreport.measures.yaw_damping import ratio_damping_groups
     from lcvreport.measures.yaw_damping import ratio_damping
     rng = np.random.default_rng(7)
     groups, signals, values, expected = [], [], [], {}
@@ -271,8 +276,9 @@ def test_the_batched_ra_peak_falls_back_to_a_golden_section_where_the_slope_brac
     names = [f"{u.name}.mass_kg" for u in v.units]
     rng = np.random.default_rng(3)
     values = {n: _nominal(v, n) * rng.uniform(0.8, 1.2, 5) for n in names}
-    peak, where = VariantBatch(v, values).ra_peak(24.0)
-    monkeypatch.setattr(VariantBatch, "_ra_slope", lambda self, s, x, t, rows: np.full(len(rows), np.nan))
-    peak2, where2 = VariantBatch(v, values).ra_peak(24.0)
+    peak, where = ra_peak_batched(VariantBatch(v, values), 24.0)
+    import lcvreport.measures.amplification as amplification
+    monkeypatch.setattr(amplification, "_ra_slope", lambda batch, s, x, t, rows: np.full(len(rows), np.nan))
+    peak2, where2 = ra_peak_batched(VariantBatch(v, values), 24.0)
     np.testing.assert_allclose(peak2, peak, rtol=1e-13)
     assert np.max(np.abs(where2 - where)) <= 1e-7

@@ -169,7 +169,7 @@ def test_a_small_forced_extremum_before_the_main_peak_is_not_the_free_decay():
     values = np.r_[0.02 * decay[0], 0.0, decay]            # the forced wiggle, then the free decay
     zeta, P = ratio_damping(values)
     assert zeta == pytest.approx(-lam.real / abs(lam), rel=1e-12)
-    from lcvreport.analysis.batch import ratio_damping_groups
+    from lcvreport.measures.yaw_damping import ratio_damping_groups
     z, _g, _s = ratio_damping_groups(np.zeros(values.size, int), np.zeros(values.size, int), values)
     assert z[0] == pytest.approx(zeta, rel=1e-15)
 

@@ -18,13 +18,16 @@ Examples
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..analysis.frequency import RA_FREQUENCY_HZ, _freq
+from ..analysis.batch import VariantBatch
+from ..analysis.frequency import RA_FREQUENCY_HZ, _freq, steer_to_acceleration
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from .registry import MeasureCase
 
 #: single sine: step [s], time after the sine [s], default amplitude [rad]
 SINGLE_SINE_STEP_S = 2e-3
@@ -190,3 +193,161 @@ def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RAPe
                               bounds=None, method="brent", options={"xtol": 1e-9})
         x = float(min(max(res.x, lo), hi))
     return RAPeak(ra1(x), x)
+
+
+def ra_peak_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(max RA(f) over 0.1-2 Hz [-], where [Hz]) of every variant: see :func:`_ra_peak_batched`
+    (groups of 256 variants)."""
+    return batch.in_groups(_ra_peak_batched, speed_mps, tire_scale)
+
+
+def _ra_slope(batch: VariantBatch, speed_mps: float, x_hz: np.ndarray, tire_scale: float,
+              rows: np.ndarray) -> np.ndarray:
+    """d ln RA / d omega of variant rows[k] at x_hz[k] [Hz] (its sign is that of dRA/df), exact:
+    ``dz/dw = -(jwM - S)^-1 jM z``, as the one-variant ``ra_peak``."""
+    co = system_coefficients(batch.vehicle)
+    c = {k: v[rows] for k, v in batch.coefficients.items()}
+    u = float(speed_mps)
+    M = c["M0"] + u * c["M1"]
+    S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+    w = 2 * np.pi * np.asarray(x_hz, dtype=float)
+    A = 1j * w[:, None, None] * M - S
+    z = np.linalg.solve(A, (tire_scale * c["Bdelta"])[..., None].astype(complex))
+    dz = np.linalg.solve(A, -1j * (M @ z))
+    # products per variant (stacks of 1-row matrices): a variant's numbers do not depend on
+    # how many others share the call (a (K, n) @ (n, 2) product may round by K)
+    z, dz = np.swapaxes(z, 1, 2), np.swapaxes(dz, 1, 2)                   # (K, 1, n)
+    ends = np.array([0, batch.vehicle.n_units - 1])
+    V, R = co.velocity_map(u)[ends].T, co.yaw_rate_map()[ends].T
+    jw = (1j * w)[:, None, None]
+    zV = z @ V
+    G = (zV * jw + u * (z @ R))[:, 0]
+    dG = (dz @ V * jw + 1j * zV + u * (dz @ R))[:, 0]
+    g = (G.conj() * dG).real / (G.conj() * G).real
+    return g[:, 1] - g[:, 0]
+
+
+def _ra_peak_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(max RA(f) over 0.1-2 Hz [-], where [Hz]) of every variant: the 0.005 Hz scan of
+    :func:`ra_peak` (on the variants' modes, :meth:`~lcvreport.analysis.batch.VariantBatch.ra_scan`),
+    then the zero of the exact slope d ln RA / d omega in each variant's best bracket (the
+    Illinois variant of regula falsi, to 1e-13 Hz; the one-variant version uses Brent's root
+    finder on the same slope), a golden-section search on RA's values where the slope does not
+    change sign across the bracket.  Each variant's search stops on its own, so its result does
+    not depend on the other variants of the batch."""
+    lo, hi = RA_BAND_HZ
+    f = np.linspace(lo, hi, 381)
+    values = batch.ra_scan(speed_mps, f, tire_scale)
+    k = np.argmax(values, axis=1)
+    where = f[k].astype(float)
+    best = batch.ra_at(speed_mps, where[:, None], tire_scale)[:, 0]          # exact at the scan's best
+    idx = np.flatnonzero((k > 0) & (k < f.size - 1))
+    if idx.size:
+        a, c = f[k[idx] - 1].astype(float), f[k[idx] + 1].astype(float)
+        ga = _ra_slope(batch, speed_mps, a, tire_scale, idx)
+        gc = _ra_slope(batch, speed_mps, c, tire_scale, idx)
+        root = (ga > 0) & (gc < 0)
+        xm = np.empty(idx.size)
+        if root.any():
+            r = np.flatnonzero(root)
+            xm[r] = _slope_zero(batch, speed_mps, tire_scale, idx[r], a[r], c[r], ga[r], gc[r])
+        if (~root).any():
+            r = np.flatnonzero(~root)
+            xm[r] = _golden(batch, speed_mps, tire_scale, idx[r], a[r], c[r])
+        xm = np.clip(xm, lo, hi)
+        vm = batch.ra_at(speed_mps, xm[:, None], tire_scale, idx)[:, 0]
+        better = vm >= best[idx]
+        best[idx] = np.where(better, vm, best[idx])
+        where[idx] = np.where(better, xm, where[idx])
+    return best, where
+
+
+def _slope_zero(batch: VariantBatch, speed_mps, tire_scale, rows, a, c, ga, gc) -> np.ndarray:
+    """The zero of :func:`_ra_slope` in [a, c] (ga > 0 > gc) of each variant of ``rows``:
+    Illinois regula falsi, each variant stopping when its iterate moves less than 1e-13 Hz."""
+    a, c, ga, gc = a.copy(), c.copy(), ga.copy(), gc.copy()
+    x = c - gc * (c - a) / (gc - ga)                 # the secant's zero (gc < 0 < ga: no 0 / 0)
+    side = np.zeros(a.size, int)                     # which end was kept last time (Illinois)
+    active = np.arange(a.size)
+    for _ in range(100):
+        if not active.size:
+            break
+        xa = x[active]
+        g = _ra_slope(batch, speed_mps, xa, tire_scale, rows[active])
+        pos = g > 0
+        # replace the end with the same sign; halve the other end's slope when kept twice
+        a[active] = np.where(pos, xa, a[active])
+        ga[active] = np.where(pos, g, np.where(side[active] == -1, 0.5 * ga[active], ga[active]))
+        c[active] = np.where(pos, c[active], xa)
+        gc[active] = np.where(pos, np.where(side[active] == 1, 0.5 * gc[active], gc[active]), g)
+        side[active] = np.where(pos, 1, -1)
+        aa, cc, gaa, gcc = a[active], c[active], ga[active], gc[active]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            new = cc - gcc * (cc - aa) / (gcc - gaa)
+        new = np.where((new > aa) & (new < cc), new, 0.5 * (aa + cc))
+        done = (np.abs(new - xa) <= 1e-13) | (g == 0) | (cc - aa <= 1e-13)
+        x[active] = np.where(g == 0, xa, new)
+        active = active[~done]
+    return x
+
+
+def _golden(batch: VariantBatch, speed_mps, tire_scale, idx, a, c) -> np.ndarray:
+    """The golden-section search of RA's values over [a, c] of each variant of ``idx``, to 1e-12 Hz."""
+    a, c = a.copy(), c.copy()
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    x1, x2 = c - g * (c - a), a + g * (c - a)
+    both = batch.ra_at(speed_mps, np.stack([x1, x2], axis=1), tire_scale, idx)
+    f1, f2 = both[:, 0], both[:, 1]
+    active = np.flatnonzero(c - a > 1e-12)
+    while active.size:
+        left = f1[active] > f2[active]                 # the maximum is in [a, x2], else in [x1, c]
+        aa, cc = a[active], c[active]
+        aa, cc = np.where(left, aa, x1[active]), np.where(left, x2[active], cc)
+        new = np.where(left, cc - g * (cc - aa), aa + g * (cc - aa))
+        f_new = batch.ra_at(speed_mps, new[:, None], tire_scale, idx[active])[:, 0]
+        x1n = np.where(left, new, x2[active])
+        x2n = np.where(left, x1[active], new)
+        f1n = np.where(left, f_new, f2[active])
+        f2n = np.where(left, f1[active], f_new)
+        a[active], c[active], x1[active], x2[active], f1[active], f2[active] = aa, cc, x1n, x2n, f1n, f2n
+        active = active[cc - aa > 1e-12]
+    return 0.5 * (a + c)
+
+
+def single_sine_batched(batch: VariantBatch, speed_mps: float, f_hz: float | None = None,
+                        tire_scale: float = 1.0) -> np.ndarray:
+    """RA of the single sine [-] of every variant: max|a_N| / max|a_1| on the continuous exact
+    response (:func:`lcvreport.measures.amplification.single_sine`: ``delta0 sin(2 pi f t)`` for one
+    period, then the tail)."""
+    from ..analysis.frequency import RA_FREQUENCY_HZ, _freq
+    from ..manoeuvres.steer import sine
+    f = float(_freq(RA_FREQUENCY_HZ if f_hz is None else f_hz))
+    steer = sine(SINGLE_SINE_DELTA0_RAD, f)
+    t_end = round((1.0 / f + SINGLE_SINE_TAIL_S) / SINGLE_SINE_STEP_S) * SINGLE_SINE_STEP_S
+    peaks = batch.ay_peaks(speed_mps, steer, t_end, SINGLE_SINE_STEP_S, [0, batch.vehicle.n_units - 1],
+                          tire_scale)
+    return peaks[:, 1] / peaks[:, 0]
+
+
+def frequency_response_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``frequency_response`` family of one case: RA at ``case.f_hz`` and every
+    unit's gain |G_i| [m/s^2 per rad]."""
+    gains = np.abs(steer_to_acceleration(case.vehicle, case.speed_mps, case.f_hz, case.tire_scale))
+    return {"ra_frequency": float(gains[-1] / gains[0]), "ay_gain_per_unit": [float(g) for g in gains]}, {}
+
+
+def ra_frequency_batched(batch: VariantBatch, speed_mps: float, f_hz: float, tire_scale: float = 1.0) -> np.ndarray:
+    """RA(f_hz) [-] of every variant (:meth:`~lcvreport.analysis.batch.VariantBatch.rearward_amplification`)."""
+    return batch.rearward_amplification(speed_mps, f_hz, tire_scale)
+
+
+def single_sine_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``single_sine`` family of one case."""
+    ss = single_sine(case.vehicle, case.speed_mps, case.f_hz, tire_scale=case.tire_scale)
+    return {"ra_single_sine": ss.rearward_amplification}, {}
+
+
+def ra_peak_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``ra_peak`` family of one case."""
+    p = ra_peak(case.vehicle, case.speed_mps, case.tire_scale)
+    return {"ra_peak": p.value, "ra_peak_frequency_hz": p.frequency_hz}, {}

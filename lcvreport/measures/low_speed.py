@@ -55,6 +55,7 @@ from ..manoeuvres.paths import StraightArcPath
 from ..model.body import TurnError, _need_bodies, _need_tracks, corners, overall_length_m
 from ..model.low_speed.kinematics import KinematicRun, KinematicsError, integrate
 from ..model.vehicle import Vehicle
+from .registry import MeasureCase
 
 
 @functools.lru_cache(maxsize=64)
@@ -424,3 +425,8 @@ def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: floa
     return LowSpeedTurn(vehicle, float(radius_m), float(angle_deg), None if lssp is None else float(lssp),
                         None if offtracking is None else float(offtracking), tail,
                         None if frontal is None else float(frontal), float(length), run, where, undefined)
+
+
+def low_speed_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``low_speed_turn`` family of one case (the speed plays no part)."""
+    return low_speed_measures(case.vehicle)

@@ -21,57 +21,45 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..analysis.frequency import RA_FREQUENCY_HZ, steer_to_acceleration
-from ..analysis.steady import Trim, check_trim, trim
+from ..analysis.batch import VariantBatch
+from ..analysis.frequency import RA_FREQUENCY_HZ
+from ..analysis.steady import Trim
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.loads import load_vector, one_percent_rule
 from ..units import mps_to_kph
-from .amplification import single_sine
-from .low_speed import low_speed_measures
-from .stability import CRITICAL_SPEED_MAX_KPH, critical_speed, least_damping
+from .registry import FAMILIES, MEASURES, MeasureCase
 
 
 @dataclass(frozen=True)
 class MeasureSet:
     """Every measure of :data:`lcvreport.measures.registry.MEASURES` for one vehicle at one
-    speed, by keyword (the registry's keys; ``trim`` holds ``trim.delta_rad`` and
-    ``trim.offtracking_m``).  ``to_dict()`` gives the JSON of ``lcv measures``, in the
-    registry's order, with ``reasons`` for every null; ``rows()`` the text and report table.
-    """
+    speed: ``values`` maps the registry's keys to numbers (None: undefined, the reason in
+    ``undefined``), and each key reads as an attribute (``m.hsso_m``); ``trim`` is the full
+    trimmed state when a residual source was given.  ``to_dict()`` gives the JSON of
+    ``lcv measures``, in the registry's order, with ``reasons`` for every null; ``rows()`` the
+    text and report table."""
 
     vehicle: Vehicle
     speed_mps: float
     tire_scale: float = 1.0
-    least_damping_ratio: float | None = None
-    least_damped_frequency_hz: float | None = None
-    critical_speed_kph: float | None = None
-    ra_frequency: float | None = None
-    ra_single_sine: float | None = None
-    ay_gain_per_unit: list[float] | None = None
-    trim: Trim | None = None
-    load_units: tuple[str, ...] = ()
     f_hz: float = RA_FREQUENCY_HZ
+    load_units: tuple[str, ...] = ()
+    sources: object = None
+    values: dict = field(default_factory=dict)
     #: measure key -> why it is null (e.g. no steered axle: no steer input to respond to)
     undefined: dict = field(default_factory=dict)
-    ra_peak: float | None = None
-    ra_peak_frequency_hz: float | None = None
-    yaw_damping_coefficient: float | None = None
-    yaw_damping_lower_bound: float | None = None
-    hsto_m: float | None = None
-    ra_lane_change: float | None = None
-    hsso_m: float | None = None
-    steady_turn_delta_rad: float | None = None
-    sources: object = None
-    lssp_m: float | None = None
-    low_speed_offtracking_m: float | None = None
-    max_tail_swing_m: float | None = None
-    frontal_swing_m: float | None = None
+    trim: Trim | None = None
+
+    def __getattr__(self, name: str):
+        if not name.startswith("_") and name in MEASURES:
+            return self.value(name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def value(self, key: str):
         """The value of the registry key ``key`` (None where undefined)."""
-        if key.startswith("trim."):
-            return None if self.trim is None else getattr(self.trim, key.split(".", 1)[1])
-        value = getattr(self, key)
+        if key == "speed_mps":
+            return self.speed_mps
+        value = self.values.get(key)
         return list(value) if isinstance(value, (list, tuple)) else value
 
     def reason(self, key: str) -> str | None:
@@ -81,26 +69,17 @@ class MeasureSet:
         if key.startswith("trim."):
             return self.undefined.get("trim", "no residual source was given (--load, --residual, "
                                               "--misalignment, --crossfall-percent, --tires)")
-        if key == "critical_speed_kph":
-            return self.undefined.get(key, f"stable at every speed up to {CRITICAL_SPEED_MAX_KPH:g} km/h")
-        if key == "least_damping_ratio" or key == "least_damped_frequency_hz":
-            return self.undefined.get(key, "no mode oscillates")
-        if key == "yaw_damping_lower_bound":
-            return "the yaw damping coefficient has a value (the bound is only given when every joint is " \
-                   "heavily damped)" if self.yaw_damping_coefficient is not None else \
-                self.undefined.get("yaw_damping_coefficient", "")
         return self.undefined.get(key, "undefined")
 
     def to_dict(self) -> dict:
-        """The JSON of ``lcv measures`` (SPEC sections 8, 12, 16): the registry's keys in its order
+        """The JSON of ``lcv measures`` (``docs/measures.md``): the registry's keys in its order
         (a dotted key nested: ``trim`` holds ``delta_rad`` and ``offtracking_m``, present with a
         residual source), and ``reasons``: {key: why it is null} for every null."""
-        from .registry import MEASURES
         doc, reasons = {}, {}
         for key in MEASURES:
             if key.startswith("trim."):
-                if self.trim is None and "trim" not in self.undefined:
-                    continue                         # no residual source: no trim (SPEC 8)
+                if "trim.delta_rad" not in self.values and "trim" not in self.undefined:
+                    continue                         # no residual source: no trim
                 doc["trim"] = None if self.trim is None else {"delta_rad": self.trim.delta_rad,
                                                               "offtracking_m": self.trim.offtracking_m}
                 if self.trim is None:
@@ -115,7 +94,6 @@ class MeasureSet:
     def rows(self) -> list[dict]:
         """The measures as table rows: name, value, unit, definition (or why it is null), and
         the key of the same number in :meth:`to_dict` (``ay_gain_per_unit[0]`` for list items)."""
-        from .registry import MEASURES
         f = f"{self.f_hz:g} Hz"
         rows = []
         for key, m in MEASURES.items():
@@ -148,9 +126,24 @@ class MeasureSet:
         return rows
 
 
+def residual_force(vehicle: Vehicle, load_units=None, sources=None, tire_scale: float = 1.0) -> np.ndarray | None:
+    """The generalized force [SI] of the 1 % rule on ``load_units`` and of ``sources`` (None if
+    neither is given): what the trim is computed against."""
+    units = tuple(load_units) if load_units else ()
+    if not units and not sources:
+        return None
+    F = np.zeros(vehicle.n_states)
+    if units:
+        F = F + load_vector(vehicle, one_percent_rule(vehicle, list(units)))
+    if sources:
+        F = F + sources.vector(vehicle, tire_scale)
+    return F
+
+
 def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, load_units=None,
                 f_hz: float = RA_FREQUENCY_HZ, sources=None) -> MeasureSet:
-    """Every measure of the registry (SPEC sections 8, 12, 16) of ``vehicle`` at ``speed_mps`` [m/s].
+    """Every measure of the registry (``docs/measures.md``) of ``vehicle`` at ``speed_mps`` [m/s]:
+    each family of :data:`lcvreport.measures.registry.FAMILIES` in turn.
 
     Parameters
     ----------
@@ -171,56 +164,50 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     >>> m = measure_set(load_preset("tractor_semitrailer"), 24.4444)
     >>> sorted(m.to_dict())[:4]
     ['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m']
+    >>> round(m.hsso_m, 4) == round(m.values["hsso_m"], 4)
+    True
     """
-    from ..analysis.exact import ManoeuvreError
-    from .amplification import ra_peak
-    from .offtracking import lane_change_measures, steady_turn
-    from .yaw_damping import _yaw_damping
-    zeta, f_zeta = least_damping(vehicle, speed_mps, tire_scale)
     units = tuple(load_units) if load_units else ()
-    has_sources = bool(units) or bool(sources)
-    low, low_why = low_speed_measures(vehicle)
-    undefined = dict(low_why)
-    common = dict(vehicle=vehicle, speed_mps=float(speed_mps), tire_scale=float(tire_scale),
-                  least_damping_ratio=zeta, least_damped_frequency_hz=f_zeta,
-                  critical_speed_kph=critical_speed(vehicle, tire_scale), load_units=units, f_hz=float(f_hz),
-                  sources=sources, **low)
-    if not vehicle.steered_axles:
-        from .registry import MEASURES
-        why = "undefined: the vehicle has no steered axle, so no steer input to respond to or trim with"
-        undefined.update({k: why for k, m in MEASURES.items() if m.needs == "steer"})
-        if has_sources:
-            undefined["trim"] = why
-        return MeasureSet(undefined=undefined, **common)
-    gains = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
-    # only the numbers are kept: each manoeuvre's response (up to a megabyte of samples) is freed
-    # before the next one is computed (a smaller heap, which malloc does not hand back and fault in)
-    ra_ss = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale).rearward_amplification
-    tr = None
-    if has_sources:
-        F = np.zeros(vehicle.n_states)
-        if units:
-            F = F + load_vector(vehicle, one_percent_rule(vehicle, list(units)))
-        if sources:
-            F = F + sources.vector(vehicle, tire_scale)
-        tr = trim(vehicle, speed_mps, F, tire_scale)
-        check_trim(tr)
-    peak = ra_peak(vehicle, speed_mps, tire_scale)
-    ydc = _yaw_damping(vehicle, speed_mps, tire_scale, zeta)
-    ydc_value, ydc_bound = ydc.value, ydc.lower_bound
-    if ydc_value is None:
-        undefined["yaw_damping_coefficient"] = f"undefined: {ydc.why}"
-    del ydc
-    try:
-        lc = lane_change_measures(vehicle, speed_mps, tire_scale)
-        hsto, ra_lc = lc.hsto_m, lc.ra_lane_change
-        del lc
-    except ManoeuvreError as exc:
-        hsto = ra_lc = None
-        undefined["hsto_m"] = undefined["ra_lane_change"] = f"undefined: {exc}"
-    turn = steady_turn(vehicle, speed_mps, tire_scale)
-    return MeasureSet(ra_frequency=float(gains[-1] / gains[0]), ra_single_sine=ra_ss,
-                      ay_gain_per_unit=[float(g) for g in gains], trim=tr, undefined=undefined,
-                      ra_peak=peak.value, ra_peak_frequency_hz=peak.frequency_hz,
-                      yaw_damping_coefficient=ydc_value, yaw_damping_lower_bound=ydc_bound, hsto_m=hsto,
-                      ra_lane_change=ra_lc, hsso_m=turn.hsso_m, steady_turn_delta_rad=turn.delta_rad, **common)
+    case = MeasureCase(vehicle, float(speed_mps), float(tire_scale), float(f_hz),
+                       residual_force(vehicle, units, sources, tire_scale))
+    values, undefined = {}, {}
+    # each family keeps only its numbers: a manoeuvre's response (up to a megabyte of samples) is
+    # freed before the next one is computed (a smaller heap, which malloc does not hand back)
+    for family in FAMILIES.values():
+        if family.applies(case):
+            v, why = family.compute(case)
+            values.update(v)
+            undefined.update(why)
+    return MeasureSet(vehicle=vehicle, speed_mps=float(speed_mps), tire_scale=float(tire_scale), f_hz=float(f_hz),
+                      load_units=units, sources=sources, values=values, undefined=undefined,
+                      trim=case.shared.get("trim"))
+
+
+def batch_measures(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None,
+                   F=None) -> dict:
+    """The batched measures of every variant of ``batch`` as columns (a dict of arrays of length
+    B, ready for ``pandas.DataFrame``): a ``case_id``, one column per varied parameter, the
+    speed, and every key of :data:`lcvreport.measures.registry.BATCHED` (the trim's,
+    ``trim.delta_rad`` and ``trim.offtracking_m``, with ``F``: (B, 2N) generalized forces [SI]);
+    NaN where a measure is undefined (no oscillatory mode, stable to 200 km/h).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lcvreport import load_preset
+    >>> v = load_preset("aucnat")
+    >>> b = VariantBatch(v, {"trailer3.mass_kg": v.units[5].mass_kg * np.array([0.8, 1.0])})
+    >>> t = batch_measures(b, 24.4444)
+    >>> bool(abs(t["hsso_m"][1] - measure_set(v, 24.4444).hsso_m) < 1e-12)
+    True
+    """
+    f_hz = RA_FREQUENCY_HZ if f_hz is None else f_hz
+    table = {"case_id": np.arange(batch.size)}
+    table.update({name: np.asarray(arr, dtype=float) for name, arr in batch.values.items()})
+    table["speed_mps"] = np.full(batch.size, float(speed_mps))
+    case = MeasureCase(batch.vehicle, float(speed_mps), float(tire_scale), float(f_hz), F)
+    for family in FAMILIES.values():
+        if family.batched and family.applies(case):
+            for key, arr in zip(family.batched_keys, family.compute_batched(batch, case)):
+                table[key] = np.asarray(arr, dtype=float)
+    return table

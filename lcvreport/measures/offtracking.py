@@ -25,12 +25,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.batch import RESPONSE_GROUP, VariantBatch
 from ..analysis.exact import ManoeuvreError, ManoeuvreResponse, check_lane_change_steer, response
-from ..analysis.steady import steady_with_yaw_rate
+from ..analysis.steady import check_trim, steady_with_yaw_rate, trim
 from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
 from ..model.yaw_plane.outputs import point_lateral_map
+from ..ranges import RANGES
+from .registry import MeasureCase
 
 #: the lane change of HSTO: A0 [g], F [Hz], time after it [s]
 LANE_CHANGE = (0.15, 0.4)
@@ -198,3 +201,114 @@ def point_path(vehicle: Vehicle, response: ManoeuvreResponse, unit: int, x_m: fl
     Theta = np.column_stack([response[f"Theta{k + 2}"] for k in range(vehicle.n_units - 1)]) \
         if vehicle.n_units > 1 else np.zeros((response.time.size, 0))
     return c[0] * response["psi1"] + c[1] * response["Y1"] + Theta @ c[2:]
+
+
+def lane_change_batched(batch: VariantBatch, speed_mps: float,
+                        tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(HSTO [m], the lane change's RA [-]) of every variant, as
+    :func:`lcvreport.measures.offtracking.lane_change_measures` (the path-following lane
+    change through each variant's inverse system): the last unit's rearmost axle's largest
+    overshoot beyond the steered axle's final offset (0 if none), and max|a_N| / max|a_s|.
+    NaN where the inverse system is unstable or does not exist, or the steer leaves
+    [-1, 1] rad (measure_set's null)."""
+    from ..analysis.exact import steered_point
+    from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
+    from ..model.yaw_plane.outputs import point_lateral_map
+    v = batch.vehicle
+    B, nu, n = batch.size, v.n_units, v.n_states
+    accel_g, f_hz = LANE_CHANGE
+    steer = lane_change(accel_g * G_MPS2, f_hz)
+    t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
+    offset = lane_change_offset_m(steer)
+    sign = 1.0 if offset >= 0 else -1.0
+    u = float(speed_mps)
+    xs = steered_point(v)
+    rear = v.units[-1].rearmost_axle
+    cmap = point_lateral_map(v, nu - 1, rear.x_m)
+    cum = np.zeros((nu - 1, n + 2))
+    for k in range(nu - 1):
+        cum[k, nu + 1:nu + 2 + k] = 1.0
+    y_row = cmap[2:] @ cum if nu > 1 else np.zeros(n + 2)
+    y_row[n] += cmap[0]
+    y_row[n + 1] += cmap[1]
+    ay_rows = batch.ay_rows(u, [nu - 1])
+
+    def signals(Mz, d_row, ctx):
+        C = np.zeros((Mz.shape[0], 4, Mz.shape[-1]))
+        C[:, 0, :n + 2] = y_row                                             # Y of the rear axle
+        C[:, 1] = ay_rows(Mz, d_row, ctx)[:, 0]                             # a_N
+        C[:, 2] = Mz[:, 0] + xs * Mz[:, 1]                                  # a_s = v1' + x_s r1' + u r1
+        C[:, 2, 1] += u
+        C[:, 3] = d_row                                                     # the steer (within [-1, 1] rad)
+        return C
+    hsto, ra = np.full(B, np.nan), np.full(B, np.nan)
+    for g in range(0, B, RESPONSE_GROUP):
+        rows = np.arange(g, min(B, g + RESPONSE_GROUP))
+        ok = batch.inverse_stable(u, tire_scale, rows)
+        rows = rows[ok]
+        if not rows.size:
+            continue
+        hi, lo = batch.extremes(u, steer, t_end, DT_S, signals, tire_scale, rows)
+        over = (hi[:, 0] - offset) if sign > 0 else -(lo[:, 0] - offset)
+        peak = np.maximum(np.abs(hi), np.abs(lo))
+        steer_ok = peak[:, 3] <= RANGES["steer_angle"].high                # else refused (measure_set's null)
+        hsto[rows[steer_ok]] = np.maximum(0.0, over[steer_ok])
+        ra[rows[steer_ok]] = peak[steer_ok, 1] / peak[steer_ok, 2]
+    return hsto, ra
+
+
+def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0, radius_m: float | None = None
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """(hsso_m, steer [rad]) of every variant in the steady turn of
+    :func:`lcvreport.measures.offtracking.steady_turn` (tractor yaw rate u/R)."""
+    R = HSSO_RADIUS_M if radius_m is None else float(radius_m)
+    u = float(speed_mps)
+    omega = u / R
+    v = batch.vehicle
+    x, delta = batch.steady(u, np.zeros(v.n_states), omega, tire_scale)
+    beta = x @ system_coefficients(v).velocity_map(u).T / u            # (B, N) CG sideslips
+    d = chain_on_circle(v, beta, R)                                     # (B, N) the chain on the circle
+    steered = max(v.steered_axles, key=lambda a: a.x_m)
+    rear = v.units[-1].rearmost_axle
+    radius = lambda unit, xp: np.hypot(xp + beta[:, unit] * d[:, unit], d[:, unit])  # noqa: E731
+    return radius(v.n_units - 1, rear.x_m) - radius(0, steered.x_m), delta
+
+
+def lane_change_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``lane_change`` family of one case (null, with the reason, where the
+    manoeuvre cannot be followed)."""
+    keys = ("hsto_m", "ra_lane_change")
+    try:
+        lc = lane_change_measures(case.vehicle, case.speed_mps, case.tire_scale)
+    except ManoeuvreError as exc:
+        return dict.fromkeys(keys), dict.fromkeys(keys, f"undefined: {exc}")
+    return {"hsto_m": lc.hsto_m, "ra_lane_change": lc.ra_lane_change}, {}
+
+
+def steady_turn_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``steady_turn`` family of one case."""
+    turn = steady_turn(case.vehicle, case.speed_mps, case.tire_scale)
+    return {"hsso_m": turn.hsso_m, "steady_turn_delta_rad": turn.delta_rad}, {}
+
+
+def trim_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``trim`` family of one case under its residual force ``case.F``."""
+    tr = trim(case.vehicle, case.speed_mps, case.F, case.tire_scale)
+    check_trim(tr)
+    case.shared["trim"] = tr
+    return {"trim.delta_rad": tr.delta_rad, "trim.offtracking_m": tr.offtracking_m}, {}
+
+
+def trim_batched(batch: VariantBatch, speed_mps: float, F=None, tire_scale: float = 1.0) -> tuple:
+    """(trim steer [rad], trimmed offtracking [m]) of every variant under its row of ``F``
+    ((B, 2N) generalized forces [SI]; NaN rows: no source, NaN results).  A batch of one
+    variant under several forces gives one row per force."""
+    if F is None:
+        return np.full(batch.size, np.nan), np.full(batch.size, np.nan)
+    F = np.asarray(F, dtype=float)
+    out = (np.full(len(F), np.nan), np.full(len(F), np.nan))
+    has = np.isfinite(F[:, 0])
+    if has.any():
+        rows = np.flatnonzero(has) if batch.size > 1 else np.zeros(int(has.sum()), int)
+        out[0][has], out[1][has] = batch.subset(rows).trim(speed_mps, F[has], tire_scale)
+    return out

@@ -24,11 +24,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.batch import VariantBatch
 from ..analysis.modes import eigenvalues, state_matrix
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.equations import check_tire_scale
 from ..ranges import RANGES
 from ..units import kph_to_mps, mps_to_kph
+from .registry import MeasureCase
 
 #: upper end of the critical-speed search [km/h]
 CRITICAL_SPEED_MAX_KPH = 200.0
@@ -59,8 +61,8 @@ def critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: float =
 
     ``max Re(lambda)`` is scanned every 4 km/h; every interval whose ends are not
     clearly stable -- closer to 0 than twice the largest change of ``max Re(lambda)``
-    over that interval and its neighbours -- is scanned again every 1 km/h; bisection narrows the first unstable speed to 0.01 km/h, rounded to
-    0.1 km/h.  An instability band narrower than 1 km/h can be missed (none of the
+    over that interval and its neighbours -- is scanned again every 1 km/h; bisection
+    narrows the first unstable speed to 0.01 km/h, rounded to 0.1 km/h.  An instability band narrower than 1 km/h can be missed (none of the
     vehicles here has one); the result equals a dense scan (tested).
 
     Examples
@@ -142,3 +144,97 @@ def speed_sweep(vehicle: Vehicle, speeds_kph, tire_scale: float = 1.0) -> SpeedS
     """Eigenvalues at every speed [km/h] (batched) and the critical speed."""
     v = np.asarray(speeds_kph, dtype=float)
     return SpeedSweep(v, eigenvalues(vehicle, kph_to_mps(v), tire_scale), critical_speed(vehicle, tire_scale))
+
+
+def least_damping_batched(batch: VariantBatch, speed_mps: float,
+                          tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(least damping ratio [-], its damped frequency [Hz]) of every variant over the oscillatory
+    modes, as :func:`lcvreport.measures.stability.least_damping` (NaN where none oscillates)."""
+    lam = batch.eigenvalues(speed_mps, tire_scale)
+    osc = lam.imag > 1e-12 * np.maximum(np.abs(lam).max(axis=-1, keepdims=True), 1.0)
+    zeta = np.where(osc, -lam.real / np.where(np.abs(lam) > 0, np.abs(lam), 1.0), np.inf)
+    k = np.argmin(zeta, axis=-1)
+    rows = np.arange(lam.shape[0])
+    best = zeta[rows, k]
+    f_hz = lam[rows, k].imag / (2 * np.pi)
+    none = ~np.isfinite(best)
+    return np.where(none, np.nan, best), np.where(none, np.nan, f_hz)
+
+
+def critical_speed_batched(batch: VariantBatch, tire_scale: float = 1.0, u_min_mps: float | None = None,
+                           u_max_kph: float | None = None) -> np.ndarray:
+    """The critical speed [km/h] of every variant (NaN: stable up to ``u_max_kph``): see
+    :func:`_critical_speed_batched` (groups of 256 variants)."""
+    return batch.in_groups(_critical_speed_batched, tire_scale, u_min_mps, u_max_kph)
+
+
+def _critical_speed_batched(batch: VariantBatch, tire_scale: float = 1.0, u_min_mps: float | None = None,
+                            u_max_kph: float | None = None) -> np.ndarray:
+    """The critical speed [km/h] of every variant (NaN: stable up to ``u_max_kph``), by the
+    algorithm of :func:`lcvreport.measures.stability.critical_speed` run on all variants at
+    once: the coarse 4 km/h scan, the 1 km/h scan of each variant's own doubtful intervals,
+    the bisection to 0.01 km/h, rounded to 0.1 km/h."""
+    from ..ranges import RANGES
+    from ..units import mps_to_kph
+    u_max_kph = CRITICAL_SPEED_MAX_KPH if u_max_kph is None else u_max_kph
+    lo_kph = mps_to_kph(RANGES["u_min"].check(U_MIN_DEFAULT_MPS if u_min_mps is None else u_min_mps, "u_min"))
+    B = batch.size
+    coarse = np.linspace(lo_kph, u_max_kph, max(int(math.ceil((u_max_kph - lo_kph) / 4.0)) + 1, 2))
+    sigma = batch.max_real_at(np.broadcast_to(coarse, (B, coarse.size)), tire_scale)     # (B, K)
+    step = np.abs(np.diff(sigma, axis=1))
+    padded = np.concatenate([step[:, :1], step, step[:, -1:]], axis=1)
+    slope = np.maximum(np.maximum(padded[:, :-2], padded[:, 1:-1]), padded[:, 2:])
+    near = np.maximum(sigma[:, :-1], sigma[:, 1:]) > -2.0 * slope                      # (B, K-1)
+    # the fine points of every interval; a variant evaluates only those of its own doubtful ones
+    fine_of = [np.linspace(coarse[i], coarse[i + 1], int(math.ceil(coarse[i + 1] - coarse[i])) + 1)[1:-1]
+               for i in range(coarse.size - 1)]
+    fine = np.concatenate(fine_of)
+    owner = np.concatenate([np.full(f.size, i) for i, f in enumerate(fine_of)])
+    use = near[:, owner]                                                                # (B, F)
+    fine_vals = np.full(use.shape, -np.inf)
+    rows, cols = np.nonzero(use)
+    if rows.size:
+        fine_vals[rows, cols] = batch.values_at(rows, fine[cols], tire_scale)
+    grid = np.concatenate([coarse, fine])
+    order = np.argsort(grid, kind="stable")
+    grid = grid[order]
+    values = np.concatenate([sigma, fine_vals], axis=1)[:, order]
+    present = np.concatenate([np.ones((B, coarse.size), bool), use], axis=1)[:, order]
+    flags = (values >= 0.0) & present
+    out = np.full(B, np.nan)
+    found = flags.any(axis=1)
+    first = np.argmax(flags, axis=1)
+    at_start = found & (first == 0)
+    out[at_start] = np.round(grid[0], 1)
+    todo = np.flatnonzero(found & (first > 0))
+    if todo.size:
+        # the previous evaluated grid point of each variant
+        idx = np.arange(grid.size)
+        prev = np.array([idx[present[b] & (idx < first[b])].max() for b in todo])
+        lo, hi = grid[prev].astype(float), grid[first[todo]].astype(float)
+        active = hi - lo > 0.01
+        while active.any():
+            mid = 0.5 * (lo + hi)
+            m = np.flatnonzero(active)
+            unstable = batch.values_at(todo[m], mid[m], tire_scale) >= 0.0
+            hi[m] = np.where(unstable, mid[m], hi[m])
+            lo[m] = np.where(unstable, lo[m], mid[m])
+            active = hi - lo > 0.01
+        out[todo] = np.round(0.5 * (lo + hi), 1)
+    return out
+
+
+def least_damping_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``least_damping`` family of one case: (values, reasons)."""
+    zeta, f_hz = least_damping(case.vehicle, case.speed_mps, case.tire_scale)
+    case.shared["least_damping_ratio"] = zeta
+    keys = ("least_damping_ratio", "least_damped_frequency_hz")
+    return dict(zip(keys, (zeta, f_hz))), ({} if zeta is not None else {k: "no mode oscillates" for k in keys})
+
+
+def critical_speed_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``critical_speed`` family of one case: (values, reasons)."""
+    v = critical_speed(case.vehicle, case.tire_scale)
+    why = {} if v is not None else {
+        "critical_speed_kph": f"stable at every speed up to {CRITICAL_SPEED_MAX_KPH:g} km/h"}
+    return {"critical_speed_kph": v}, why

@@ -18,9 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.batch import RESPONSE_GROUP, VariantBatch
 from ..analysis.exact import ManoeuvreResponse, response
 from ..manoeuvres.steer import pulse
 from ..model.vehicle import Vehicle
+from .registry import MeasureCase
 
 #: the YDC pulse: amplitude [rad], duration [s]; the window after it [s]
 YDC_PULSE = (0.01, 0.5)
@@ -144,3 +146,118 @@ def _yaw_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float, zeta_mod
                           f"largest after the pulse (a decay faster than x20 per half cycle), so YDC >= "
                           f"{YDC_HEAVY_ZETA:.4f}", YDC_HEAVY_ZETA)
     return YawDamping(min(defined), per_joint, amps, ext, zeta_modal, r)
+
+
+def yaw_damping_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+    """The yaw damping coefficient [-] of every variant
+    (:func:`lcvreport.measures.yaw_damping.yaw_damping_coefficient`: the pulse, each joint's
+    extrema from its end to 40 s after on the continuous response, the ratio method, the
+    smallest over the joints); NaN where no joint has two amplitudes."""
+    from ..manoeuvres.steer import pulse
+    v = batch.vehicle
+    B = batch.size
+    out = np.full(B, np.nan)
+    if v.n_units < 2:
+        return out
+    A, D = YDC_PULSE
+    steer = pulse(A, D)
+    t_end = round((D + YDC_WINDOW_S) / YDC_DT_S) * YDC_DT_S
+    lo, hi = D + 1e-12, D + YDC_WINDOW_S - 1e-12
+    joints = v.n_units - 1
+    extrema = []
+    for g in range(0, B, RESPONSE_GROUP):
+        rows = np.arange(g, min(B, g + RESPONSE_GROUP))
+        found = []
+        for Mz, _z0, Z, _z_end, ka, _kb, _d, (_A, _b, m, n) in batch.pieces(speed_mps, steer, t_end, YDC_DT_S,
+                                                                           tire_scale, rows, positions=False):
+            if Z is None:
+                continue
+            C = np.zeros((rows.size, joints, Mz.shape[-1]))                 # theta rows over z
+            C[:, np.arange(joints), v.n_units + 1 + np.arange(joints)] = 1.0
+            b_i, s_i, t, val, _y = batch.between_samples(Z, C, Mz, YDC_DT_S, ka * YDC_DT_S)
+            keep = (t > lo) & (t < hi)
+            found.append((b_i[keep], s_i[keep], t[keep], val[keep]))
+        b_i, s_i, t, val = (np.concatenate(a) for a in zip(*found))
+        extrema.append((rows[b_i], s_i, t, val))
+    b_i, s_i, t, val = (np.concatenate(a) for a in zip(*extrema))
+    order = np.lexsort((t, s_i, b_i))                     # by variant, joint, time
+    zeta, b_of, _s = ratio_damping_groups(b_i[order], s_i[order], val[order])
+    np.fmin.at(out, b_of, zeta)                            # the smallest over a variant's joints
+    return out
+
+
+def ratio_damping_groups(group: np.ndarray, signal: np.ndarray, values: np.ndarray):
+    """:func:`ratio_damping` of many signals at once: ``values``
+    holds each signal's extrema in time order, the signals one after the other, labelled by
+    ``(group, signal)``.  Returns (zeta, group, signal) of every signal with two kept amplitudes
+    or more (the same arithmetic in the same order: equal to the one-signal function to a few ulp,
+    numpy's vectorised logarithm and its scalar one differing by an ulp at most).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = np.exp(-0.3 * np.pi / 2 * np.arange(8)) * (-1.0) ** np.arange(8)
+    >>> z, g, s = ratio_damping_groups(np.zeros(8, int), np.zeros(8, int), A)
+    >>> from lcvreport.measures.yaw_damping import ratio_damping
+    >>> bool(abs(z[0] - ratio_damping(A)[0]) <= 1e-15)
+    True
+    """
+    group, signal, values = np.asarray(group), np.asarray(signal), np.asarray(values, dtype=float)
+    empty = (np.zeros(0), np.zeros(0, int), np.zeros(0, int))
+    if values.size < 3:
+        return empty
+    new = np.r_[True, (group[1:] != group[:-1]) | (signal[1:] != signal[:-1])]
+    label = np.cumsum(new) - 1                                  # one label per signal
+    same = label[1:] == label[:-1]
+    P = np.abs(np.diff(values))[same]                           # peak-to-peak amplitudes
+    lab = label[1:][same]
+    if not P.size:
+        return empty
+    starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
+    pmax = np.maximum.reduceat(P, starts)
+    which = np.cumsum(np.r_[True, lab[1:] != lab[:-1]]) - 1   # index into starts
+    idx = np.arange(P.size)
+    first_max = np.minimum.reduceat(np.where(P == pmax[which], idx, P.size), starts)
+    # the free decay starts at each signal's largest amplitude; from it on, those >= 5 % of it
+    keep = (idx >= first_max[which]) & (P >= YDC_MIN_FRACTION * pmax[which])
+    rank = np.cumsum(keep)
+    before = np.r_[0, rank][starts][which]                      # kept amplitudes before the signal's first
+    keep &= (rank - before) <= YDC_MAX_AMPLITUDES
+    P, lab = P[keep], lab[keep]
+    pair = lab[1:] == lab[:-1]
+    d = np.log(P[:-1][pair] / P[1:][pair])
+    z = d / np.sqrt(np.pi ** 2 + d ** 2)
+    zl = lab[:-1][pair]
+    if not zl.size:
+        return empty
+    firsts = np.flatnonzero(np.r_[True, zl[1:] != zl[:-1]])
+    counts = np.diff(np.r_[firsts, zl.size])
+    sums = np.add.reduceat(z, firsts)
+    idx = np.flatnonzero(new)[zl[firsts]]                        # each signal's first element
+    return sums / counts, group[idx], signal[idx]
+
+
+def yaw_damping_family_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0) -> tuple:
+    """(yaw damping coefficient [-], its lower bound [-]) of every variant: the registry's batched
+    ``yaw_damping`` family (the bound 0.6901 where every joint is heavily damped, else NaN)."""
+    zeta = yaw_damping_batched(batch, speed_mps, tire_scale)
+    bound = np.where(np.isnan(zeta) & (batch.vehicle.n_units > 1), YDC_HEAVY_ZETA, np.nan)
+    return zeta, bound
+
+
+def yaw_damping_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``yaw_damping`` family of one case: the coefficient and, when every joint
+    is heavily damped, its lower bound."""
+    zeta = case.shared.get("least_damping_ratio")
+    if "least_damping_ratio" not in case.shared:
+        from .stability import least_damping
+        zeta = least_damping(case.vehicle, case.speed_mps, case.tire_scale)[0]
+    ydc = _yaw_damping(case.vehicle, case.speed_mps, case.tire_scale, zeta)
+    why = {}
+    if ydc.value is None:
+        why["yaw_damping_coefficient"] = f"undefined: {ydc.why}"
+    if ydc.lower_bound is None:
+        why["yaw_damping_lower_bound"] = ("the yaw damping coefficient has a value (the bound is only given when "
+                                          "every joint is heavily damped)") if ydc.value is not None else \
+            why["yaw_damping_coefficient"]
+    return {"yaw_damping_coefficient": ydc.value, "yaw_damping_lower_bound": ydc.lower_bound}, why

@@ -19,6 +19,7 @@ from __future__ import annotations
 from functools import lru_cache
 from importlib import resources
 
+from ..units import THESIS
 from .vehicle import Vehicle
 from .vehicle_file import loads_vehicle
 
@@ -71,7 +72,27 @@ def load_preset(name: str, masses: str = "table") -> Vehicle:
     if masses not in MASS_OPTIONS:
         raise ValueError(f"masses must be one of {', '.join(MASS_OPTIONS)}, got {masses!r}")
     vehicle = loads_vehicle(preset_path(name).read_text(encoding="utf-8"), source=f"preset {name}")
-    if masses == "unrounded":
-        from ..thesis.vehicles import unrounded_masses_kg  # the thesis' own correction of its Table C
+    if masses == "unrounded":                   # the thesis' own correction of its Table C
         vehicle = vehicle.with_masses(unrounded_masses_kg(name))
     return vehicle
+
+
+#: the gaps file's keys of the unrounded masses [lbf*s^2/in] of each preset that has them
+UNROUNDED_KEYS = {"tractor_semitrailer": "four_dof_lbf_s2_per_in", "aucnat": "twelve_dof_lbf_s2_per_in"}
+
+
+def unrounded_masses_kg(name: str) -> list[float]:
+    """The unrounded masses the published matrices imply [kg], from the data file
+    ``data/thesis/gaps.toml`` (``[unrounded_masses]``; see ``docs/thesis.md``).
+
+    Raises
+    ------
+    ValueError
+        For a preset other than ``aucnat`` and ``tractor_semitrailer``.
+    """
+    import tomllib
+    key = UNROUNDED_KEYS.get(name)
+    if key is None:
+        raise ValueError(f"unrounded masses are known only for aucnat and tractor_semitrailer, not {name!r}")
+    gaps = resources.files(__package__.partition(".")[0]).joinpath("data", "thesis", "gaps.toml")
+    return [m * THESIS.mass_kg for m in tomllib.loads(gaps.read_text(encoding="utf-8"))["unrounded_masses"][key]]

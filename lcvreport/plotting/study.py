@@ -8,17 +8,17 @@ from matplotlib.figure import Figure
 from .style import PAGE_WIDTH_IN, PALETTE, SMALL_PT
 
 
-def _study_label(name: str) -> str:
+def _study_label(name: str, unit: str) -> str:
     """``trailer3.cornering_stiffness_scale`` -> three short lines and the unit (panels are narrow)."""
     text = name.replace(".", "\n").replace("_stiffness_", "_stiffness\n")
-    from ..measures.registry import unit_of
-    return f"{text} [{unit_of(name)}]"
+    return f"{text} [{unit}]"
 
 
-def fig_study_scatter(table, factors: list[str], measures: list[str], max_points: int = 2000,
+def fig_study_scatter(table, factors: list[str], measures: list[str], units: dict, max_points: int = 2000,
                       seed: int = 0) -> Figure:
     """Every measure (rows) against every factor (columns): the cases (at most ``max_points``,
-    drawn with a fixed seed) and the median per bin of the factor."""
+    drawn with a fixed seed) and the median per bin of the factor.  ``units`` maps every column
+    to its unit (the registry's, :func:`lcvreport.measures.registry.unit_of`)."""
     nrows, ncols = len(measures), len(factors)
     fig = Figure(figsize=(PAGE_WIDTH_IN, max(1.6, 1.35 * nrows + 0.4)), layout="constrained")
     axes = fig.subplots(nrows, ncols, squeeze=False)
@@ -44,14 +44,15 @@ def fig_study_scatter(table, factors: list[str], measures: list[str], max_points
                 ax.plot(centres, med, "-", color=PALETTE[1], lw=1.2)
             ax.tick_params(labelsize=SMALL_PT)
             if i == nrows - 1:
-                ax.set_xlabel(_study_label(f), fontsize=SMALL_PT)
+                ax.set_xlabel(_study_label(f, units[f]), fontsize=SMALL_PT)
             if j == 0:
-                ax.set_ylabel(_study_label(m), fontsize=SMALL_PT)
+                ax.set_ylabel(_study_label(m, units[m]), fontsize=SMALL_PT)
     return fig
 
 
-def study_pass_rates(rates) -> Figure:
-    """Pass rate [%] against each factor, one line per limit (and all together)."""
+def study_pass_rates(rates, units: dict) -> Figure:
+    """Pass rate [%] against each factor, one line per limit (and all together); ``units`` maps
+    every factor to its unit."""
     factors = list(rates.by_factor)
     fig = Figure(figsize=(PAGE_WIDTH_IN, 2.4), layout="constrained")
     axes = fig.subplots(1, max(1, len(factors)), squeeze=False)
@@ -62,7 +63,7 @@ def study_pass_rates(rates) -> Figure:
             ax.plot(centres, 100 * r, "o-" if key == "all" else ".-", ms=3, lw=1.0,
                     color="black" if key == "all" else PALETTE[k % len(PALETTE)], label=key)
         ax.set_ylim(-3, 103)
-        ax.set_xlabel(_study_label(f), fontsize=SMALL_PT)
+        ax.set_xlabel(_study_label(f, units[f]), fontsize=SMALL_PT)
         ax.tick_params(labelsize=SMALL_PT)
         if j == 0:
             ax.set_ylabel("cases passing [%]", fontsize=SMALL_PT)

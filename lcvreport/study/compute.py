@@ -23,6 +23,7 @@ from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ
 from ..measures.measure_set import measure_set
 from ..measures.registry import BATCHED as BATCH_GROUPS
+from ..measures.registry import FAMILIES, MeasureCase
 from .spec import BATCHED, Study
 
 
@@ -54,8 +55,8 @@ def compute_chunk(study: Study, case_ids) -> dict:
             values = {k: arr[rows] for k, arr in params.items()}
             batch = VariantBatch(v, values)
             for group in groups:
-                arrays = batch.measure_group(group, float(u), float(ts), RA_FREQUENCY_HZ,
-                                             None if F is None else F[rows])
+                case = MeasureCase(v, float(u), float(ts), RA_FREQUENCY_HZ, None if F is None else F[rows])
+                arrays = FAMILIES[group].compute_batched(batch, case)
                 for name, arr in zip(BATCH_GROUPS[group], arrays):
                     if name in batched:
                         cols[name][rows] = np.broadcast_to(arr, rows.shape)

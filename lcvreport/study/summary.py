@@ -59,8 +59,9 @@ class PassRates:
     by_factor: dict
 
     def plot(self):
+        from ..measures.registry import unit_of
         from ..plotting.study import study_pass_rates
-        return study_pass_rates(self)
+        return study_pass_rates(self, {f: unit_of(f) for f in self.by_factor})
 
 
 def pass_rates(table, criteria, factors, bins: int = 8) -> PassRates:

@@ -161,21 +161,6 @@ def preset_file_text(name: str) -> str:
     return dumps_vehicle(v, header=header, unit_comments=unit_comments, axle_comments=axle_comments)
 
 
-def unrounded_masses_kg(name: str) -> list[float]:
-    """The unrounded masses the published matrices imply [kg] (SPEC section 3, ``gaps.toml``).
-
-    Raises
-    ------
-    ValueError
-        For a preset other than ``aucnat`` and ``tractor_semitrailer``.
-    """
-    g = gaps()["unrounded_masses"]
-    key = {"tractor_semitrailer": "four_dof_lbf_s2_per_in", "aucnat": "twelve_dof_lbf_s2_per_in"}.get(name)
-    if key is None:
-        raise ValueError(f"unrounded masses are known only for aucnat and tractor_semitrailer, not {name!r}")
-    return [m * THESIS.mass_kg for m in g[key]]
-
-
 def write_preset_files(directory: Path) -> list[Path]:
     """Write every preset's vehicle file into ``directory``."""
     directory = Path(directory)
