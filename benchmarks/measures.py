@@ -28,17 +28,17 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lcvreport import load_preset, load_vehicle  # noqa: E402
-from lcvreport.measures.offtracking import lane_change_measures, steady_turn
-from lcvreport.measures.amplification import ra_peak
-from lcvreport.measures.yaw_damping import yaw_damping_coefficient
 from lcvreport.analysis.frequency import RA_FREQUENCY_HZ, steer_to_acceleration
-from lcvreport.measures.stability import critical_speed, least_damping
-from lcvreport.measures.measure_set import measure_set
-from lcvreport.measures.amplification import single_sine
-from lcvreport.analysis.steady import trim
 from lcvreport.analysis.modes import state_matrix  # noqa: E402
-from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule  # noqa: E402
+from lcvreport.analysis.steady import trim
+from lcvreport.measures.amplification import ra_peak, single_sine
+from lcvreport.measures.measure_set import measure_set
+from lcvreport.measures.offtracking import lane_change_measures, steady_turn
+from lcvreport.measures.stability import critical_speed, least_damping
+from lcvreport.measures.yaw_damping import yaw_damping_coefficient
+from lcvreport.model.linear import linear_model
 from lcvreport.model.presets import PRESETS  # noqa: E402
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule  # noqa: E402
 from lcvreport.units import kph_to_mps  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -89,7 +89,7 @@ def main() -> None:
         dominant = max(parts, key=parts.get)
         if v.n_units == 6:
             worst_six = max(worst_six, t_all)
-        print(f"{v.name:22s} {v.n_units:5d} {v.n_states:6d} {t_bare * 1e3:9.3f} {t_all * 1e3:9.2f} "
+        print(f"{v.name:22s} {v.n_units:5d} {linear_model(v).n_states:6d} {t_bare * 1e3:9.3f} {t_all * 1e3:9.2f} "
               f"{t_all / t_bare:6.0f}  " + " ".join(f"{parts[k] * 1e3:{8 if i < 2 else 7}.2f}"
                                                    for i, k in enumerate(parts)) + f"  {dominant}")
     print(f"slowest 6-unit vehicle: {worst_six * 1e3:.2f} ms per (vehicle, speed)  (target <= 30 ms)")
@@ -105,8 +105,8 @@ def lapack_replay(fn) -> tuple[float, float, int]:
     """(time of ``fn()``, the sum of the times of the linear-algebra calls it makes, replayed
     alone with the same arguments, the number of those calls).  The calls are recorded by
     wrapping numpy.linalg's and scipy.linalg's functions for one run of ``fn``."""
-    import importlib
     import copy
+    import importlib
     recorded = []
     saved = []
     for mod_name, names in PRIMITIVES:

@@ -20,6 +20,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``presets``          the six thesis vehicles, shipped as vehicle files
     ``plausibility``     warnings for legal but implausible numbers (unit typos)
     ``body``             the body of every unit: kind, extent, corners, overall length, poses
+    ``linear``           the model seam: LinearModel (what analysis needs of any linear model), MODELS
     ``yaw_plane/``       the linear yaw-plane model of the thesis, ``M x' = S x + F``:
         ``equations``    M, S and the input matrices of any chain (SI or thesis units)
         ``states``       the state names and the joint letters

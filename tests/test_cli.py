@@ -13,19 +13,19 @@ import time
 
 import numpy as np
 import pytest
+from conftest import EXAMPLE_NAMES, EXAMPLES
 
-from lcvreport.model.yaw_plane.outputs import rear_offsets
 from lcvreport.analysis.modes import eigenvalues
 from lcvreport.analysis.steady import steady_state
 from lcvreport.cli.main import EXIT_BROKEN_PIPE, run
-from lcvreport.model.yaw_plane.equations import system_matrices
-from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
+from lcvreport.model.linear import linear_model
 from lcvreport.model.presets import PRESETS, load_preset
 from lcvreport.model.vehicle_file import load_vehicle
+from lcvreport.model.yaw_plane.equations import system_matrices
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
+from lcvreport.model.yaw_plane.outputs import rear_offsets
 from lcvreport.ranges import RANGES
 from lcvreport.units import THESIS
-
-from conftest import EXAMPLE_NAMES, EXAMPLES
 
 MPS_PER_MPH = 0.44704       # typed here on purpose
 WESTERN = str(EXAMPLES / "western_double.toml")
@@ -78,7 +78,7 @@ def test_every_command_works_on_every_example(name):
     v = load_vehicle(path)
     last = v.unit_names[-1]
     eig = lcv_json("eig", "--vehicle", path, "--speed-kph", "88")
-    assert len(eig["eigenvalues"]) == v.n_states
+    assert len(eig["eigenvalues"]) == linear_model(v).n_states
     steady = lcv_json("steady", "--vehicle", path, "--speed-kph", "88", "--load", last)
     x = steady_state(v, 88 / 3.6, load_vector(v, one_percent_rule(v, [last])))
     assert steady["state"]["r1"] == pytest.approx(x[1], rel=1e-12)

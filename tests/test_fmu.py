@@ -14,15 +14,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
+from fmu_support import Slave, run_schedule
+from helpers import group_error, held_inputs, reference_outputs, schedule, schedule_condition, tolerance
 
 from lcvreport.analysis.modes import eigenvalues
 from lcvreport.fmu.engine import LCVEngine
 from lcvreport.fmu.interface import preset_interface, preset_value
-from lcvreport.model.yaw_plane.equations import system_coefficients
+from lcvreport.model.linear import linear_model
 from lcvreport.model.presets import PRESETS, load_preset
-
-from fmu_support import Slave, run_schedule
-from helpers import group_error, held_inputs, reference_outputs, schedule, schedule_condition, tolerance
+from lcvreport.model.yaw_plane.equations import system_coefficients
 
 ITF = preset_interface()
 AXLES = ("11", "12", "13", "21", "31", "41", "51", "61")
@@ -129,7 +129,7 @@ def test_lateral_accelerations_and_max_real_eig_are_the_package_values(preset_fm
     for k, w in enumerate(held_inputs(ITF, steps)):
         u = max(w[0], 2.2352)
         Ca, Da = co.acceleration_maps(u)
-        x = np.array([ref_z[k, names.index(n)] for n in v.state_names])
+        x = np.array([ref_z[k, names.index(n)] for n in linear_model(v).state_names])
         ay = Ca @ x + Da @ (Bw @ w)
         np.testing.assert_allclose(got[k, ay_cols], ay, rtol=1e-8, atol=1e-10 * np.abs(ay).max())
         assert got[k, names.index("max_real_eig")] == pytest.approx(eigenvalues(v, u).real.max(), rel=1e-9)
@@ -290,6 +290,7 @@ def test_libcosim_and_ecos_do_not_see_the_preset_enumeration(native_fmu, tmp_pat
     lists Enumerations, this test fails and the README's advice can go."""
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimSlave import CosimLocalSlave
+
     from lcvreport.fmu.build import build_vehicle_fmus
     ex = CosimExecution.from_step_size(step_size=10_000_000)
     idx = ex.add_local_slave(CosimLocalSlave(fmu_path=str(native_fmu), instance_name="lcv"))
@@ -364,8 +365,8 @@ def test_outputs_read_after_new_inputs_without_a_step_use_the_new_inputs(preset_
     eng = LCVEngine(ITF, "aucnat")
     Bw = eng.maps()["Bw"]
     names = s.outputs
-    x = np.array([before[names.index(n)] for n in v.state_names])
-    np.testing.assert_array_equal([after[names.index(n)] for n in v.state_names], x)   # the state has not moved
+    x = np.array([before[names.index(n)] for n in linear_model(v).state_names])
+    np.testing.assert_array_equal([after[names.index(n)] for n in linear_model(v).state_names], x)   # the state has not moved
     w = eng.start_inputs()
     for name, value in (("delta", -0.02), ("P61", 500.0), ("P41", -800.0), ("u", 15.0)):
         w[eng.input_index[name]] = value
@@ -386,7 +387,7 @@ def test_a_misalignment_input_drives_the_fmu_to_the_packages_steady_state(preset
     s.set(eps41=0.002, eps21=-0.001, u=20.0)
     for _ in range(12):
         s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=5.0)
-    got = s.get(list(v.state_names[:1]) + [f"r{i}" for i in range(1, 7)] + ["thetaA", "thetaB", "thetaC", "thetaD",
+    got = s.get(list(linear_model(v).state_names[:1]) + [f"r{i}" for i in range(1, 7)] + ["thetaA", "thetaB", "thetaC", "thetaD",
                                                                              "thetaE"])
     s.free()
     F = ResidualSources(misalignment_rad={"41": 0.002, "21": -0.001}).vector(v, tire_scale=0.8)

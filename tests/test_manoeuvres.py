@@ -10,25 +10,25 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import EXAMPLES
+from helpers import chain_on_circle_by_root_finding
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from lcvreport import load_preset, load_vehicle
-from lcvreport.measures.offtracking import HSSO_RADIUS_M, steady_turn
-from lcvreport.measures.amplification import ra_peak
-from lcvreport.measures.yaw_damping import ratio_damping, yaw_damping_coefficient
 from lcvreport.analysis.discretize import augmented_state_matrix
 from lcvreport.analysis.exact import ManoeuvreError, response
-from lcvreport.manoeuvres.steer import (G_MPS2, SteerError, lane_change, lane_change_offset_m, parse_steer, pulse, sine,
-                                        step, table)
-from lcvreport.measures.measure_set import measure_set
 from lcvreport.analysis.frequency import steer_to_acceleration
 from lcvreport.analysis.steady import trim
+from lcvreport.manoeuvres.steer import (G_MPS2, SteerError, lane_change, lane_change_offset_m, parse_steer, pulse, sine,
+                                        step, table)
+from lcvreport.measures.amplification import ra_peak
+from lcvreport.measures.measure_set import measure_set
+from lcvreport.measures.offtracking import HSSO_RADIUS_M, steady_turn
+from lcvreport.measures.yaw_damping import ratio_damping, yaw_damping_coefficient
+from lcvreport.model.linear import linear_model
 from lcvreport.model.yaw_plane.equations import system_coefficients
 from lcvreport.model.yaw_plane.loads import ResidualLoads, ResidualSources
-
-from conftest import EXAMPLES
-from helpers import chain_on_circle_by_root_finding
 
 U88 = 88 / 3.6
 
@@ -71,7 +71,7 @@ def test_exact_response_equals_a_stiff_ode_solve_for_every_steer_kind(name, kind
     F = srcs.vector(v)
     r = response(v, U88, steer, 6.0, 0.01, F)
     ref = _radau(v, U88, steer, r.time, F)
-    names = list(v.state_names) + ["psi1", "Y1"]
+    names = list(linear_model(v).state_names) + ["psi1", "Y1"]
     got = np.column_stack([r[n] for n in names])
     scale = np.abs(ref).max(axis=0)
     assert np.max(np.abs(got - ref) / scale) <= 1e-9
@@ -172,7 +172,7 @@ def test_yaw_damping_extrema_equal_those_of_a_stiff_ode_solve():
                      rtol=1e-12, atol=1e-16)
     sol = solve_ivp(lambda t, x: A @ x, (0.5, 40.5), sol0.y[:, -1], method="Radau", rtol=1e-12, atol=1e-16,
                     dense_output=True)
-    j = v.state_names.index("thetaA")
+    j = linear_model(v).state_names.index("thetaA")
     dtheta = lambda t: (A @ sol.sol(t))[j]                                         # noqa: E731
     grid = np.linspace(0.5, 40.5, 40001)
     d = np.array([dtheta(t) for t in grid[::10]])
@@ -195,7 +195,7 @@ def test_hsso_equals_a_long_run_holding_the_turns_steer(name):
     turn = steady_turn(v, U88)
     r = response(v, U88, step(turn.delta_rad), 300.0, 0.5)
     co = system_coefficients(v)
-    x = np.array([r[n][-1] for n in v.state_names])
+    x = np.array([r[n][-1] for n in linear_model(v).state_names])
     omega = r["r1"][-1]
     assert U88 / omega == pytest.approx(HSSO_RADIUS_M, rel=1e-6)        # the radius read off the run
     vel = co.velocity_map(U88) @ x

@@ -10,26 +10,25 @@ import sys
 import control
 import numpy as np
 import pytest
+from conftest import EXAMPLE_NAMES, EXAMPLES
 
-from lcvreport.measures.stability import U_MIN_DEFAULT_MPS, critical_speed, least_damping
-from lcvreport.tracking.tires import conicity_sensitivity
-from lcvreport.measures.measure_set import measure_set
-from lcvreport.analysis.frequency import rearward_amplification, steer_to_acceleration
-from lcvreport.analysis.steady import reference_points, trim
-from lcvreport.measures.amplification import single_sine
 from lcvreport.analysis.discretize import augmented_state_matrix, discretize
-from lcvreport.model.yaw_plane.outputs import global_lateral, point_longitudinal
+from lcvreport.analysis.frequency import rearward_amplification, steer_to_acceleration
 from lcvreport.analysis.modes import eigenvalues
 from lcvreport.analysis.response import simulate
 from lcvreport.analysis.statespace import to_statespace
-from lcvreport.analysis.steady import steady_state
-from lcvreport.model.yaw_plane.equations import system_coefficients
-from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
+from lcvreport.analysis.steady import reference_points, steady_state, trim
+from lcvreport.measures.amplification import single_sine
+from lcvreport.measures.measure_set import measure_set
+from lcvreport.measures.stability import U_MIN_DEFAULT_MPS, critical_speed, least_damping
+from lcvreport.model.linear import linear_model
 from lcvreport.model.presets import PRESETS, load_preset
 from lcvreport.model.vehicle_file import load_vehicle
+from lcvreport.model.yaw_plane.equations import system_coefficients
+from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
+from lcvreport.model.yaw_plane.outputs import global_lateral, point_longitudinal
+from lcvreport.tracking.tires import conicity_sensitivity
 from lcvreport.units import kph_to_mps, mps_to_kph
-
-from conftest import EXAMPLE_NAMES, EXAMPLES
 
 U88 = kph_to_mps(88.0)
 
@@ -59,7 +58,7 @@ def sine_run(v, f: float, delta0: float, T: float, h: float):
     whole (autonomous) system.  Returns time [s] and the lateral accelerations [m/s^2]."""
     import scipy.linalg
     co = system_coefficients(v)
-    n = v.n_states
+    n = linear_model(v).n_states
     A, G = co.state_derivative_maps(U88)
     Ca, Da = co.acceleration_maps(U88)
     b = G @ co.B_delta()
@@ -106,7 +105,7 @@ def test_to_statespace_agrees_with_the_measures(name):
         np.testing.assert_allclose(G, steer_to_acceleration(v, U88, f)[:, i], rtol=1e-10)
     # the DC gain of the states is the steady state
     x_ss = steady_state(v, U88, system_coefficients(v).B_delta())
-    dc = control.dcgain(sys_)[:v.n_states, 0]
+    dc = control.dcgain(sys_)[:linear_model(v).n_states, 0]
     np.testing.assert_allclose(dc, x_ss, rtol=1e-9, atol=1e-12 * np.abs(x_ss).max())
 
 
@@ -141,7 +140,7 @@ def test_single_sine_is_the_response_to_the_continuous_sine_with_its_peaks_betwe
     f = 0.4
     delta = lambda t: 0.01 * np.sin(2 * np.pi * f * t) if t <= 1 / f else 0.0      # noqa: E731
     sols = []
-    x0 = np.zeros(v.n_states)
+    x0 = np.zeros(linear_model(v).n_states)
     for a, c in ((0.0, 1 / f), (1 / f, ss.time[-1])):
         sol = solve_ivp(lambda t, x: A @ x + b * delta(t), (a, c), x0, method="Radau", rtol=1e-12, atol=1e-16,
                         dense_output=True)

@@ -15,15 +15,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from lcvreport import PRESETS, load_preset, load_vehicle
-from lcvreport.measures.offtracking import HSSO_RADIUS_M, steady_turn
-from lcvreport.measures.yaw_damping import ratio_damping, yaw_damping_coefficient
-from lcvreport.measures.low_speed import low_speed_turn
-from lcvreport.model.vehicle import Axle, Unit, Vehicle
-
 from conftest import EXAMPLES, TOOLS
 from helpers import chain_on_circle_by_root_finding, random_vehicle, steady_turn_newton_euler
+
+from lcvreport import PRESETS, load_preset, load_vehicle
+from lcvreport.measures.low_speed import low_speed_turn
+from lcvreport.measures.offtracking import HSSO_RADIUS_M, steady_turn
+from lcvreport.measures.yaw_damping import ratio_damping, yaw_damping_coefficient
+from lcvreport.model.linear import linear_model
+from lcvreport.model.vehicle import Axle, Unit, Vehicle
 
 ROOT = Path(__file__).resolve().parents[1]
 LCV = [sys.executable, "-m", "lcvreport.cli"]
@@ -128,7 +128,7 @@ def _ydc_by_the_corrected_spec(v, u):
     t = r.time
     zetas = []
     for k in range(v.n_units - 1):
-        y = r[v.state_names[v.n_units + 1 + k]]
+        y = r[linear_model(v).state_names[v.n_units + 1 + k]]
         i = np.flatnonzero((np.diff(np.sign(np.diff(y))) != 0) & (t[1:-1] > 0.5) & (t[1:-1] < 40.5))
         ext = []
         for j in i + 1:
@@ -349,8 +349,9 @@ def test_the_turn_angle_has_one_range_for_the_api_and_the_cli():
 
 # ---------------------------------------------------------------------------- --help, criteria, reasons
 def _commands():
-    from lcvreport.cli.main import build_parser
     import argparse
+
+    from lcvreport.cli.main import build_parser
     out = []
 
     def walk(parser, prefix):
@@ -403,11 +404,11 @@ def test_a_misspelt_measure_names_the_key_to_use(tmp_path, key, hint):
 def test_a_study_judges_the_trim_the_criteria_file_names(tmp_path):
     """The trim in a study and in a criteria file is one key: the study report's pass rates hold
     the trim's limit (the first version dropped it silently)."""
+    from lcvreport.measures.criteria import load_criteria
+    from lcvreport.study.results import read_study
     from lcvreport.study.run import run_study
     from lcvreport.study.spec import study_from_dict
-    from lcvreport.study.results import read_study
     from lcvreport.study.summary import pass_rates
-    from lcvreport.measures.criteria import load_criteria
     out = tmp_path / "s"
     run_study(study_from_dict({"vehicle": "aucnat", "speed_kph": 88.0, "measures": ["trim.offtracking_m", "hsso_m"],
                                "factors": {"load_units": {"values": [["trailer3"], ["trailer2", "trailer3"]]}}}), out)
@@ -431,9 +432,10 @@ def test_model_exchange_at_fmusims_default_tolerance_is_within_1_percent(tmp_pat
     follows the exact response to a steer step (0.01 rad from rest, 6 s) within 1 % of every
     lateral acceleration's and state's peak (with nominals of 1 it read ay3 23 % off; 1.4 % on
     the western double)."""
+    from fmu_support import host_env, interface_of
+
     from lcvreport.analysis.exact import response
     from lcvreport.manoeuvres.steer import step
-    from fmu_support import host_env, interface_of
     for fmu, vehicle in [(native_fmu, load_preset("aucnat"))] + \
             [(all_example_fmus[n]["native"], load_vehicle(EXAMPLES / f"{n}.toml")) for n in ("western_double",
                                                                                               "b_double")]:
@@ -447,10 +449,10 @@ def test_model_exchange_at_fmusims_default_tolerance_is_within_1_percent(tmp_pat
         rows = list(csv.DictReader(open(out)))
         itf = interface_of(fmu)
         r = response(vehicle, float(itf.by_name["u"].start), step(0.01), 6.0, 0.05)
-        letters = {f"theta{k + 1}": v for k, v in enumerate(vehicle.state_names[vehicle.n_units + 1:])}
+        letters = {f"theta{k + 1}": v for k, v in enumerate(linear_model(vehicle).state_names[vehicle.n_units + 1:])}
         names = [f"ay{i + 1}" for i in range(vehicle.n_units)] + [f"r{i + 1}" for i in range(vehicle.n_units)] + \
             ([f"theta{k + 1}" for k in range(vehicle.n_units - 1)] if not itf.preset_mode else
-             list(vehicle.state_names[vehicle.n_units + 1:]))
+             list(linear_model(vehicle).state_names[vehicle.n_units + 1:]))
         for name in names:
             got = np.array([float(x[name]) for x in rows])
             ref = r[letters.get(name, name) if not itf.preset_mode else name]
@@ -488,6 +490,7 @@ def test_the_fmu_gives_hsto_through_every_axles_lateral_position(all_example_fmu
     """Y_<axle> of every axle: in a steer step the FMU's equals the package's exact path of the
     axle's centre (the FMU steps exactly for inputs held over the step)."""
     from fmpy import simulate_fmu
+
     from lcvreport.analysis.exact import response
     from lcvreport.manoeuvres.steer import step
     v = load_vehicle(EXAMPLES / "b_double.toml")

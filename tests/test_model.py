@@ -6,20 +6,20 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.linalg
+from conftest import EXAMPLES
+from helpers import random_vehicle, speeds, vehicles
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lcvreport import eigenvalues, modes, steady_state
 from lcvreport.analysis.modes import sort_eigenvalues
-from lcvreport.model.yaw_plane.equations import system_coefficients, system_matrices
-from lcvreport.model.yaw_plane.loads import ResidualLoads, load_vector
+from lcvreport.model.linear import linear_model
 from lcvreport.model.presets import PRESETS, load_preset
 from lcvreport.model.vehicle import Axle, Unit, Vehicle
 from lcvreport.model.vehicle_file import load_vehicle
+from lcvreport.model.yaw_plane.equations import system_coefficients, system_matrices
+from lcvreport.model.yaw_plane.loads import ResidualLoads, load_vector
 from lcvreport.units import SI, THESIS, UnitSystem
-
-from conftest import EXAMPLES
-from helpers import random_vehicle, speeds, vehicles
 
 SETTINGS = settings(max_examples=40, deadline=None, derandomize=True)
 
@@ -53,7 +53,7 @@ def test_two_axle_truck_is_the_textbook_bicycle_model(m, I, a, b, Cf, Cr, u):
     A_ref = np.array([[-(Cf + Cr) / (m * u), -(Cf * a - Cr * b) / (m * u) - u],
                       [-(Cf * a - Cr * b) / (I * u), -(Cf * a * a + Cr * b * b) / (I * u)]])
     np.testing.assert_allclose(np.linalg.solve(co.M(u), co.S(u)), A_ref, rtol=1e-12)
-    assert truck.state_names == ("v1", "r1")
+    assert linear_model(truck).state_names == ("v1", "r1")
 
 
 # ---------------------------------------------------------------------------- Newton-Euler with joint forces
@@ -128,7 +128,7 @@ def test_any_chain_equals_newton_euler(vehicle, u, s):
 
 def test_no_upper_limit_on_the_number_of_units():
     v = random_vehicle(15, np.random.default_rng(3))
-    assert v.n_units == 15 and v.state_names[-1] == "thetaN"
+    assert v.n_units == 15 and linear_model(v).state_names[-1] == "thetaN"
     lam = eigenvalues(v, 20.0)
     assert lam.size == 30
     assert_same_spectrum(newton_euler_eigenvalues(v, 20.0), lam, 1e-9)
@@ -197,4 +197,4 @@ def test_presets_geometry_and_signs(preset):
     assert v.axles[0].tires == 2 and all(ax.tires == 4 for ax in v.axles[1:])
     assert all(ax.dual_spacing_m == pytest.approx(0.3048) for ax in v.axles[1:])
     n = 2 if preset == "tractor_semitrailer" else 6
-    assert v.n_units == n and len(v.state_names) == 2 * n
+    assert v.n_units == n and len(linear_model(v).state_names) == 2 * n

@@ -33,8 +33,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..model.linear import linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import system_coefficients
 from ..util.numerics import solve_scaled
 
 #: the coefficients the batch varies, and the parameters it can vary
@@ -89,17 +89,19 @@ def _nominal(vehicle: Vehicle, name: str) -> float:
 
 @dataclass
 class VariantBatch:
-    """``B`` variants of ``vehicle``: ``values`` maps parameter names to arrays of shape (B,) (SI)."""
+    """``B`` variants of ``vehicle``: ``values`` maps parameter names to arrays of shape (B,) (SI);
+    ``model`` is the linear model they are computed on (:data:`lcvreport.model.linear.MODELS`)."""
 
     vehicle: Vehicle
     values: dict
+    model: str = "yaw_plane"
     coefficients: dict = field(init=False, repr=False)
 
     def __post_init__(self):
         lengths = {np.shape(v) for v in self.values.values()}
         if len(lengths) > 1 or any(len(s) != 1 for s in lengths):
             raise BatchError(f"every parameter needs an array of one length, got shapes {sorted(lengths)}")
-        base = system_coefficients(self.vehicle)
+        base = linear_model(self.vehicle, self.model)
         B = next(iter(lengths))[0] if lengths else 1
         coeffs = {k: np.broadcast_to(getattr(base, k), (B,) + getattr(base, k).shape).copy() for k in COEFFICIENTS}
         for name, arr in self.values.items():
@@ -108,7 +110,7 @@ class VariantBatch:
                 raise BatchError(f"{name}: every value must be finite and > 0")
             p0 = _nominal(self.vehicle, name)
             step = p0 if p0 > 0 else 1.0
-            bumped = system_coefficients(_with(self.vehicle, name, p0 + step))
+            bumped = linear_model(_with(self.vehicle, name, p0 + step), self.model)
             for k in COEFFICIENTS:
                 d = (getattr(bumped, k) - getattr(base, k)) / step
                 coeffs[k] += (arr - p0).reshape((B,) + (1,) * d.ndim) * d
@@ -122,6 +124,7 @@ class VariantBatch:
         """The variants ``rows`` as a batch of their own (sharing the coefficients' rows)."""
         sub = object.__new__(VariantBatch)
         sub.vehicle = self.vehicle
+        sub.model = self.model
         sub.values = {k: np.asarray(a)[rows] for k, a in self.values.items()}
         sub.coefficients = {k: a[rows] for k, a in self.coefficients.items()}
         return sub
@@ -159,7 +162,7 @@ class VariantBatch:
         [m/s^2 per rad] of every variant, shape (B, N), as
         :func:`lcvreport.analysis.frequency.steer_to_acceleration` (the velocity and yaw-rate
         maps depend on the geometry only, which the batch does not vary)."""
-        co = system_coefficients(self.vehicle)
+        co = linear_model(self.vehicle, self.model)
         c = self.coefficients
         u = float(speed_mps)
         M = c["M0"] + u * c["M1"]
@@ -202,7 +205,7 @@ class VariantBatch:
         return self._ra_at_block(speed_mps, f_hz, tire_scale, rows)
 
     def _ra_at_block(self, speed_mps: float, f_hz: np.ndarray, tire_scale: float, rows=None) -> np.ndarray:
-        co = system_coefficients(self.vehicle)
+        co = linear_model(self.vehicle, self.model)
         c = {k: (v if rows is None else v[rows]) for k, v in self.coefficients.items()}
         u = float(speed_mps)
         M = (c["M0"] + u * c["M1"])[:, None]
@@ -219,7 +222,7 @@ class VariantBatch:
         eigendecomposition (the exact solves cost O(n^3) per frequency).  It only chooses the
         peak's bracket; every value returned by :meth:`ra_peak` is an exact solve.  Variants whose
         eigenvectors are ill-conditioned (cond(V) > 1e8) are scanned with the exact solves."""
-        co = system_coefficients(self.vehicle)
+        co = linear_model(self.vehicle, self.model)
         c = self.coefficients
         u = float(speed_mps)
         M = c["M0"] + u * c["M1"]
@@ -266,7 +269,7 @@ class VariantBatch:
         from scipy.linalg import expm
         c = {k: a[rows] for k, a in self.coefficients.items()}
         u = float(speed_mps)
-        n, B = self.vehicle.n_states, rows.size
+        n, B = linear_model(self.vehicle, self.model).n_states, rows.size
         m = n + 2 if positions else n
         M = c["M0"] + u * c["M1"]
         S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
@@ -403,7 +406,7 @@ class VariantBatch:
 
     def ay_rows(self, speed_mps: float, units):
         """``signals`` of :meth:`_extremes`: the CG lateral accelerations of ``units`` (0-based)."""
-        co = system_coefficients(self.vehicle)
+        co = linear_model(self.vehicle, self.model)
         u = float(speed_mps)
         Vmap, Rmap = co.velocity_map(u)[units], co.yaw_rate_map()[units]
 
@@ -428,7 +431,7 @@ class VariantBatch:
         lateral acceleration to the steer (the test of :func:`lcvreport.analysis.exact.response`)."""
         from .exact import steered_point
         c = {k: a[rows] for k, a in self.coefficients.items()}
-        n = self.vehicle.n_states
+        n = linear_model(self.vehicle, self.model).n_states
         M = c["M0"] + u * c["M1"]
         S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
         AG = solve_scaled(M, np.concatenate([S, np.broadcast_to(np.eye(n), (rows.size, n, n))], axis=-1))

@@ -24,8 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..manoeuvres.drivers import DEFAULT, PreviewDriver
+from ..model.linear import check_speed, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, system_coefficients
+from ..model.yaw_plane.equations import system_coefficients
 from ..model.yaw_plane.loads import ResidualLoads, load_vector
 from .discretize import Discretizer, augmented_state_matrix
 from .response import TimeResponse
@@ -68,7 +69,7 @@ def steer_feedback(vehicle: Vehicle, speed_mps: float, gains: tuple[float, float
     F = load_vector(vehicle, ResidualLoads(residual_P_N or {}, residual_T_Nm or {}))
     b = co.B_delta(tire_scale)
     Ad, Gd = Discretizer(vehicle, maxsize=1)(speed_mps, h, tire_scale)
-    n = vehicle.n_states
+    n = linear_model(vehicle).n_states
     k_y, k_psi = gains
     z = np.zeros((n_steps + 1, n + 2))
     delta = np.zeros(n_steps + 1)

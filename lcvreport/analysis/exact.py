@@ -37,9 +37,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..manoeuvres.steer import SteerInput
+from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
-from ..model.yaw_plane.outputs import point_lateral_map, rear_end_weights
+from ..model.yaw_plane.outputs import rear_end_weights
 from .discretize import augmented_state_matrix
 from .extrema import _hermite_roots, _quintic, _scan
 
@@ -248,16 +248,17 @@ def steered_point(vehicle: Vehicle) -> float:
     return max(a.x_m for a in vehicle.steered_axles)
 
 
-def inverse_zeros(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+def inverse_zeros(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, model: str = "yaw_plane"
+                  ) -> np.ndarray:
     """Eigenvalues of the inverse system from the steered axle's lateral acceleration to
     the steer: the zeros of that transfer function [1/s]."""
-    A, b, Cs, Ds = _steer_axle_maps(vehicle, speed_mps, tire_scale)
+    A, b, Cs, Ds = _steer_axle_maps(vehicle, speed_mps, tire_scale, model)
     return np.linalg.eigvals(A - np.outer(b, Cs) / Ds)
 
 
-def _steer_axle_maps(vehicle, speed_mps, tire_scale):
+def _steer_axle_maps(vehicle, speed_mps, tire_scale, model: str = "yaw_plane"):
     """x' = A x + b delta (+ G F); a_s = Cs x + Ds delta (+ Js G F)."""
-    co = system_coefficients(vehicle)
+    co = linear_model(vehicle, model)
     A, G = co.state_derivative_maps(speed_mps, tire_scale)
     b = G @ co.B_delta(tire_scale)
     xs = steered_point(vehicle)
@@ -270,7 +271,7 @@ def _steer_axle_maps(vehicle, speed_mps, tire_scale):
 
 def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float, dt: float,
              F: np.ndarray | None = None, tire_scale: float = 1.0, t_start: float = 0.0,
-             state: np.ndarray | None = None) -> ManoeuvreResponse:
+             state: np.ndarray | None = None, model: str = "yaw_plane") -> ManoeuvreResponse:
     """The exact response from rest to ``steer`` (continuous) and the constant
     generalized force ``F`` (residual sources, SI), sampled every ``dt`` to ``t_end``.
 
@@ -290,6 +291,9 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
     t_start, state : float, numpy.ndarray, optional
         Start later than 0 from ``state`` = [x, psi1, Y1] at ``t_start`` (a run in
         chunks); the samples are then ``t_start + k dt``.
+    model : str
+        The linear model (:data:`lcvreport.model.linear.MODELS`; default the yaw plane):
+        its states, and the positions and accelerations it defines.
 
     Raises
     ------
@@ -303,8 +307,8 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
     n_steps = int(round(span / dt))
     if n_steps < 1 or abs(n_steps * dt - span) > 1e-9 * max(span, 1.0):
         raise ValueError(f"dt = {dt:g} s must divide t_end - t_start = {span:g} s")
-    co = system_coefficients(vehicle)
-    n = vehicle.n_states
+    co = linear_model(vehicle, model)
+    n = co.n_states
     nu = vehicle.n_units
     m = n + 2
     Aa, Ga = augmented_state_matrix(co, u, tire_scale)
@@ -316,7 +320,7 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
     aF = Da @ F
     lane = steer.prescribes_acceleration
     if lane:
-        A_x, b, Cs, Ds = _steer_axle_maps(vehicle, u, tire_scale)
+        A_x, b, Cs, Ds = _steer_axle_maps(vehicle, u, tire_scale, model)
         if abs(Ds) < 1e-12 * max(1.0, np.abs(Cs).max()):
             raise ManoeuvreError("lane change: the steer does not reach the steered axle's lateral acceleration "
                                  "directly; the inverse system does not exist")
@@ -329,22 +333,16 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
                                  "follow the path; the manoeuvre is refused")
         fs = float(np.r_[1.0, steered_point(vehicle)] @ (co.state_derivative_maps(u, tire_scale)[1] @ F)[:2])
     # signal rows over [x, psi1, Y1] (before the input's own part): states, psi1, Y1, ay, a_steer, Y_axles, Theta
-    names = list(vehicle.state_names) + ["psi1", "Y1"]
+    names = list(co.state_names) + ["psi1", "Y1"]
     V_ay = np.zeros((nu, m))
     V_ay[:, :n] = Ca
     names_ay = [f"ay{i + 1}" for i in range(nu)]
     xs = steered_point(vehicle) if vehicle.steered_axles else None
     Y_rows, Y_names = [], []
-    cum = np.zeros((nu - 1, m))
-    for k in range(nu - 1):
-        cum[k, nu + 1:nu + 2 + k] = 1.0
+    cum = co.heading_rows()
     for i, unit in enumerate(vehicle.units):
         for a in unit.axles:
-            c = point_lateral_map(vehicle, i, a.x_m)
-            row = c[2:] @ cum
-            row[n] += c[0]
-            row[n + 1] += c[1]
-            Y_rows.append(row)
+            Y_rows.append(co.point_lateral_row(i, a.x_m))
             Y_names.append(f"Y_{a.name}")
     signal_names = tuple(["delta"] + names + names_ay + ["a_steer"] + Y_names +
                          [f"Theta{k + 2}" for k in range(nu - 1)])
@@ -447,5 +445,5 @@ def check_lane_change_steer(r: ManoeuvreResponse, peak_rad: float | None = None)
 def final_state(r: ManoeuvreResponse) -> np.ndarray:
     """[x, psi1, Y1] at the last sample of ``r`` (to continue a run in chunks)."""
     seg = r.segments[-1]
-    m = r.vehicle.n_states + 2
+    m = linear_model(r.vehicle).n_states + 2
     return seg.Z[-1, :m].copy()

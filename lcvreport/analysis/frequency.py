@@ -9,11 +9,10 @@ Examples
 """
 from __future__ import annotations
 
-
 import numpy as np
 
+from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
 from ..ranges import RANGES
 
 #: the frequency of the RA measures [Hz]
@@ -27,18 +26,19 @@ def _freq(f_hz):
     return f
 
 
-def steer_to_acceleration(vehicle: Vehicle, speed_mps: float, f_hz, tire_scale: float = 1.0) -> np.ndarray:
+def steer_to_acceleration(vehicle: Vehicle, speed_mps: float, f_hz, tire_scale: float = 1.0,
+                          model: str = "yaw_plane") -> np.ndarray:
     """``G_i(j 2 pi f)``: complex gain from the steer angle to the lateral acceleration of
     every unit's CG [m/s^2 per rad], shape (..., N) for frequencies of shape (...).
 
     Computed from ``x = (j w M - S)^-1 b_delta`` and ``a = (j w V + u R) x``, with no
     state-space conversion (the state-space form of :mod:`.statespace` is tested
-    against it).
+    against it), on the linear model ``model`` (default the yaw plane).
     """
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
     f = _freq(f_hz)
-    co = system_coefficients(vehicle)
+    co = linear_model(vehicle, model)
     M, S, b = co.M(speed_mps), co.S(speed_mps, tire_scale), co.B_delta(tire_scale)
     V, R = co.velocity_map(speed_mps), co.yaw_rate_map()
     w = 2 * np.pi * f[..., None, None]
@@ -46,8 +46,9 @@ def steer_to_acceleration(vehicle: Vehicle, speed_mps: float, f_hz, tire_scale: 
     return x @ V.T * (1j * 2 * np.pi * f[..., None]) + speed_mps * (x @ R.T)
 
 
-def rearward_amplification(vehicle: Vehicle, speed_mps: float, f_hz=RA_FREQUENCY_HZ, tire_scale: float = 1.0):
-    """``RA(f) = |G_N| / |G_1|`` [-] at one or many frequencies [Hz]."""
-    G = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale))
+def rearward_amplification(vehicle: Vehicle, speed_mps: float, f_hz=RA_FREQUENCY_HZ, tire_scale: float = 1.0,
+                           model: str = "yaw_plane"):
+    """``RA(f) = |G_N| / |G_1|`` [-] at one or many frequencies [Hz] on the model ``model``."""
+    G = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale, model))
     ra = G[..., -1] / G[..., 0]
     return float(ra) if np.ndim(ra) == 0 else ra

@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.linear import check_speed, check_tire_scale
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.equations import system_coefficients
 from ..units import SI, UnitSystem
 from .modes import mode_order
 

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
 from ..util.numerics import solve_scaled
 
 
@@ -143,20 +143,22 @@ def sort_eigenvalues(eigenvalues: np.ndarray) -> np.ndarray:
     return np.take_along_axis(lam, mode_order(lam), axis=-1)
 
 
-def state_matrix(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0
-                 ) -> np.ndarray:
-    """``A = M^-1 S`` (SI) at forward speed [m/s]; broadcasts over speed and tire scale."""
+def state_matrix(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0,
+                 model: str = "yaw_plane") -> np.ndarray:
+    """``A = M^-1 S`` (SI) of the linear model ``model`` (:data:`lcvreport.model.linear.MODELS`)
+    at forward speed [m/s]; broadcasts over speed and tire scale."""
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
-    co = system_coefficients(vehicle)
+    co = linear_model(vehicle, model)
     S = co.S(speed_mps, tire_scale)
     M = np.broadcast_to(co.M(speed_mps), S.shape)
     return solve_scaled(M, S)
 
 
-def eigenvalues(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0
-                ) -> np.ndarray:
-    """Eigenvalues [1/s] in mode order; broadcasts over arrays of speed [m/s] and tire scale.
+def eigenvalues(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0,
+                model: str = "yaw_plane") -> np.ndarray:
+    """Eigenvalues [1/s] of the model ``model`` in mode order; broadcasts over arrays of speed
+    [m/s] and tire scale.
 
     Examples
     --------
@@ -164,22 +166,22 @@ def eigenvalues(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: flo
     >>> eigenvalues(load_preset("aucnat"), [10.0, 20.0, 30.0]).shape
     (3, 12)
     """
-    return sort_eigenvalues(np.linalg.eigvals(state_matrix(vehicle, speed_mps, tire_scale)))
+    return sort_eigenvalues(np.linalg.eigvals(state_matrix(vehicle, speed_mps, tire_scale, model)))
 
 
-def _modes_one(vehicle: Vehicle, speed: float, tire_scale: float) -> Modes:
+def _modes_one(vehicle: Vehicle, speed: float, tire_scale: float, model: str = "yaw_plane") -> Modes:
     # the same routine as eigenvalues(): the balanced, scaled state matrix (QZ on the
     # unscaled pencil (S, M) lost up to two digits on long chains)
-    lam, X = np.linalg.eig(state_matrix(vehicle, speed, tire_scale))
+    lam, X = np.linalg.eig(state_matrix(vehicle, speed, tire_scale, model))
     order = mode_order(lam)
     lam, X = lam[order], X[:, order]
     k = np.argmax(np.abs(X), axis=0)
     X = X / X[k, np.arange(X.shape[1])]
-    return Modes(lam, X, vehicle.state_names, float(speed), float(tire_scale))
+    return Modes(lam, X, linear_model(vehicle, model).state_names, float(speed), float(tire_scale))
 
 
-def modes(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0
-          ) -> Modes | list[Modes]:
+def modes(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0,
+          model: str = "yaw_plane") -> Modes | list[Modes]:
     """Eigenvalues and mode shapes of ``M^-1 S`` at forward speed [m/s].
 
     Parameters
@@ -189,6 +191,8 @@ def modes(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | n
         Forward speed [m/s]; an array gives one :class:`Modes` per element.
     tire_scale : float or array
         Tire coefficient factor [-]; broadcasts with ``speed_mps``.
+    model : str
+        The linear model (:data:`lcvreport.model.linear.MODELS`; default the yaw plane).
 
     Returns
     -------
@@ -203,6 +207,6 @@ def modes(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | n
     u = check_speed(speed_mps)
     s = check_tire_scale(tire_scale)
     if u.ndim == 0 and s.ndim == 0:
-        return _modes_one(vehicle, float(u), float(s))
+        return _modes_one(vehicle, float(u), float(s), model)
     ub, sb = np.broadcast_arrays(u, s)
-    return [_modes_one(vehicle, float(a), float(b)) for a, b in zip(ub.ravel(), sb.ravel())]
+    return [_modes_one(vehicle, float(a), float(b), model) for a, b in zip(ub.ravel(), sb.ravel())]

@@ -22,8 +22,9 @@ from typing import Iterator
 
 import numpy as np
 
+from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.equations import system_coefficients
 from ..model.yaw_plane.outputs import rear_end_global, rear_offsets
 from ..ranges import RANGES, RangeError
 from .discretize import GLOBAL_STATES, Discretizer
@@ -59,7 +60,7 @@ class TimeResponse:
     @property
     def names(self) -> tuple[str, ...]:
         """State names, model order then psi1, Y1."""
-        return self.vehicle.state_names + GLOBAL_STATES
+        return linear_model(self.vehicle).state_names + GLOBAL_STATES
 
     @property
     def signal_names(self) -> tuple[str, ...]:
@@ -96,7 +97,7 @@ class TimeResponse:
     def lateral_acceleration(self) -> np.ndarray:
         """a_i = v_i' + u r_i of every unit's CG [m/s^2], shape (K, N) (SPEC section 8)."""
         co = system_coefficients(self.vehicle)
-        n2 = self.vehicle.n_states
+        n2 = linear_model(self.vehicle).n_states
         out = np.empty((self.time.size, self.vehicle.n_units))
         for u in np.unique(self.speed_mps):
             sel = self.speed_mps == u
@@ -168,7 +169,7 @@ def simulate(vehicle: Vehicle, time: np.ndarray, speed_mps: float | np.ndarray, 
     u = np.broadcast_to(np.asarray(speed_mps, dtype=float), (k,))
     check_speed(u)
     check_tire_scale(tire_scale)
-    n = vehicle.n_states
+    n = linear_model(vehicle).n_states
     f = np.broadcast_to(np.asarray(forces, dtype=float), (k, n))
     disc = discretizer or Discretizer(vehicle)
     z = np.zeros((t.size, n + 2))
@@ -214,7 +215,7 @@ def step_response(vehicle: Vehicle, speed_mps: float, F: np.ndarray, t_end: floa
     # points equal to rounding
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
-    n = vehicle.n_states
+    n = linear_model(vehicle).n_states
     f = np.broadcast_to(np.asarray(F, dtype=float), (n,))
     Ad, Gd = Discretizer(vehicle, maxsize=1)(float(speed_mps), float(t_end) / (t.size - 1), tire_scale)
     b = Gd @ f
@@ -242,7 +243,7 @@ def iter_step_response(vehicle: Vehicle, speed_mps: float, F: np.ndarray, dt: fl
     check_tire_scale(tire_scale)
     Ad, Gd = Discretizer(vehicle, maxsize=1)(speed_mps, dt, tire_scale)
     b = Gd @ np.asarray(F, dtype=float)
-    z = np.zeros(vehicle.n_states + 2)
+    z = np.zeros(linear_model(vehicle).n_states + 2)
     yield 0.0, z
     for k in range(1, int(n_steps) + 1):
         with np.errstate(over="ignore", invalid="ignore"):   # checked just below

@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.equations import system_coefficients
 from ..model.yaw_plane.outputs import rear_end_weights
 
 
@@ -72,7 +73,7 @@ def state_space(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> 
     Cy = rear_end_weights(vehicle) @ cum
     C = np.vstack([np.eye(2 * n), Ca, Cy])
     D = np.vstack([np.zeros((2 * n, Bw.shape[1])), Da @ Bw, np.zeros((n - 1, Bw.shape[1]))])
-    states = vehicle.state_names
+    states = linear_model(vehicle).state_names
     outputs = states + tuple(f"ay{i}" for i in range(1, n + 1)) + tuple(f"y{k}" for k in range(2, n + 1))
     inputs = input_names(vehicle)
     units_of = {"v1": "m/s", **{f"r{i}": "rad/s" for i in range(1, n + 1)},

@@ -14,14 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
 from ..model.yaw_plane.outputs import point_lateral_map, point_longitudinal
 from ..ranges import RANGES, RangeError
 
 
 def steady_state(vehicle: Vehicle, speed_mps: float | np.ndarray, F: np.ndarray,
-                 tire_scale: float | np.ndarray = 1.0) -> np.ndarray:
+                 tire_scale: float | np.ndarray = 1.0, model: str = "yaw_plane") -> np.ndarray:
     """Steady state ``x_ss = -S^-1 F`` under a constant generalized force (SI).
 
     Parameters
@@ -32,15 +32,17 @@ def steady_state(vehicle: Vehicle, speed_mps: float | np.ndarray, F: np.ndarray,
     F : numpy.ndarray, shape (..., 2N)
         Generalized force, SI (row 1 N, rows 2..N+1 N*m; see :func:`lcvreport.load_vector`).
     tire_scale : float or array
+    model : str
+        The linear model (default the yaw plane); F has its state count.
 
     Returns
     -------
-    numpy.ndarray, shape (..., 2N)
-        v1 [m/s], r [rad/s], theta [rad].
+    numpy.ndarray, shape (..., n)
+        The steady state (yaw plane: v1 [m/s], r [rad/s], theta [rad]).
     """
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
-    S = system_coefficients(vehicle).S(speed_mps, tire_scale)
+    S = linear_model(vehicle, model).S(speed_mps, tire_scale)
     Fb = np.broadcast_to(np.asarray(F, dtype=float), S.shape[:-1])
     return -np.linalg.solve(S, Fb[..., None])[..., 0]
 
@@ -73,8 +75,8 @@ def reference_points(vehicle: Vehicle) -> tuple[tuple[int, float], tuple[int, fl
     return (0, q.x_m), (last, vehicle.units[last].rearmost_axle.x_m)
 
 
-def steady_with_yaw_rate(vehicle: Vehicle, speed_mps: float, F, r1: float, tire_scale: float = 1.0
-                         ) -> tuple[np.ndarray, float]:
+def steady_with_yaw_rate(vehicle: Vehicle, speed_mps: float, F, r1: float, tire_scale: float = 1.0,
+                         model: str = "yaw_plane") -> tuple[np.ndarray, float]:
     """The steady state and steer angle with the tractor's yaw rate held at ``r1`` [rad/s]:
     ``S x + b delta + F = 0`` with ``x[1] = r1`` (the trim: r1 = 0; a steady turn: u/R).
 
@@ -86,9 +88,9 @@ def steady_with_yaw_rate(vehicle: Vehicle, speed_mps: float, F, r1: float, tire_
     """
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
-    co = system_coefficients(vehicle)
+    co = linear_model(vehicle, model)
     S, b = co.S(speed_mps, tire_scale), co.B_delta(tire_scale)
-    n = vehicle.n_states
+    n = co.n_states
     K = np.zeros((n + 1, n + 1))
     K[:n, :n] = S
     K[:n, n] = b

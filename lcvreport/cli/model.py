@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 
+from ..model.linear import linear_model
 from ..units import SI, THESIS
 from .options import _load_vector, _speed_mps, _speed_text, _vehicle
 from .output import _finite, _Out
@@ -53,12 +54,12 @@ def _cmd_matrices(args, out: _Out) -> int:
     _finite(M, S, F)
     label = "thesis units: lbf, in, s" if units is THESIS else "SI: N, m, kg, s"
     if args.json:
-        doc = {"state": list(v.state_names), "units": label, "M": M.tolist(), "S": S.tolist()}
+        doc = {"state": list(linear_model(v).state_names), "units": label, "M": M.tolist(), "S": S.tolist()}
         if F is not None:
             doc["F"] = F.tolist()
         out.json(doc)
         return 0
-    out.line(f"state = {list(v.state_names)}  ({label})")
+    out.line(f"state = {list(linear_model(v).state_names)}  ({label})")
     out.line("M =")
     out.line(np.array2string(M, precision=6, max_line_width=200))
     out.line("S =")
@@ -78,7 +79,7 @@ def _cmd_steady(args, out: _Out) -> int:
     n = v.n_units
     y = rear_offsets(v, x[n + 1:])
     _finite(x, y)
-    state = {name: float(value) for name, value in zip(v.state_names, x)}
+    state = {name: float(value) for name, value in zip(linear_model(v).state_names, x)}
     ydoc = {f"y{k + 2}": float(val) for k, val in enumerate(y)}
     if args.json:
         out.json({"state": state, "y": ydoc})

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from ..model.linear import linear_model
 from ..ranges import RANGES, RangeError
 from .options import UsageError, _load_vector, _sources, _speed_mps, _vehicle
 from .output import _finite, _Out
@@ -32,7 +33,7 @@ def _cmd_simulate(args, out: _Out) -> int:
         raise UsageError(f"argument --steer: {exc}") from None
     if args.steer is not None and not v.steered_axles:
         raise UsageError(f"argument --steer: {v.name} has no steered axle")
-    F = _load_vector(args, v) if args.load is not None else np.zeros(v.n_states)
+    F = _load_vector(args, v) if args.load is not None else np.zeros(linear_model(v).n_states)
     try:
         F = F + _sources(args, v).vector(v, args.tire_scale)
     except (KeyError, RangeError) as exc:

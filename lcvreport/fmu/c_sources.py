@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..model.linear import linear_model
 from ..ranges import RANGES
 from .engine import STATE_MAGIC, LCVEngine
 from .interface import U_MIN_DEFAULT, Interface
@@ -78,7 +79,7 @@ def _c_string(text: str) -> str:
 
 
 def _sizes(itf: Interface) -> dict:
-    n = max(v.n_states for v in itf.vehicles)
+    n = max(linear_model(v).n_states for v in itf.vehicles)
     m = n + 2
     nb = m + n
     return {"states": n, "units": max(v.n_units for v in itf.vehicles), "m": m,
@@ -174,7 +175,7 @@ def vehicle_data_header(itf: Interface) -> str:
         for col, var in enumerate(itf.inputs):
             if var.source[0] == "steer":
                 maps["Bw"][:, col] = 0.0     # the FMU fills it with tire_scale * Bdelta
-        n, N = v.n_states, v.n_units
+        n, N = linear_model(v).n_states, v.n_units
         Vq = np.zeros((N, n))
         Vq[:, :N + 1] = co.Jv
         Vth = np.zeros((N, n))

@@ -10,6 +10,7 @@ from xml.etree.ElementTree import Element, SubElement
 
 import numpy as np
 
+from ..model.linear import linear_model
 from ..units import M_PER_FT, M_PER_IN, MPS_PER_MPH, N_PER_LBF, NM_PER_LBF_FT, NM_PER_LBF_IN, S_PER_HOUR
 from .interface import FmuVariable, Interface
 
@@ -61,7 +62,7 @@ def _state_dependencies(itf: Interface) -> dict:
         for o, v in enumerate(itf.outputs):
             kind = v.source[0]
             if kind == "ay":
-                deps[v.name] |= {name for j, name in z_of.items() if j < vehicle.n_states}
+                deps[v.name] |= {name for j, name in z_of.items() if j < linear_model(vehicle).n_states}
             elif kind == "y":
                 deps[v.name] |= {z_of[j] for j in heading_z if j in z_of and np.any(maps["W"][o] != 0)}
             elif kind != "max_real_eig":

@@ -36,6 +36,7 @@ import math
 import numpy as np
 
 from ..analysis.discretize import augmented_state_matrix
+from ..model.linear import linear_model
 from ..model.yaw_plane.equations import system_coefficients
 from ..model.yaw_plane.outputs import point_lateral_map, rear_end_weights
 from ..ranges import RANGES, RangeError
@@ -101,7 +102,7 @@ class LCVEngine:
         self.co = system_coefficients(vehicle)
         # the crossfall's constant generalized force: one more input column, always 1
         self._Fc = math.sin(math.atan(self.crossfall / 100.0)) * self.co.B_crossfall
-        self.n = vehicle.n_states
+        self.n = linear_model(vehicle).n_states
         self.m = self.n + 2
         self.input_names = tuple(v.name for v in interface.inputs)
         self.input_index = {name: k for k, name in enumerate(self.input_names)}
@@ -156,7 +157,7 @@ class LCVEngine:
         rear_row = c[2:] @ cum
         rear_row[n] += c[0]
         rear_row[n + 1] += c[1]
-        states = v.state_names
+        states = linear_model(v).state_names
         for o, var in enumerate(self.interface.outputs):
             kind = var.source[0]
             if kind == "state" and var.source[1] in states:

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.linear import linear_model
 from ..model.presets import PRESETS
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.states import joint_letter
@@ -183,7 +184,7 @@ class Interface:
             names = []
             for var in self.continuous_states:
                 i = self.state_index(var, v)
-                names.append(None if i < 0 else (list(v.state_names) + ["psi1", "Y1"])[i])
+                names.append(None if i < 0 else (list(linear_model(v).state_names) + ["psi1", "Y1"])[i])
             if v.steered_axles:
                 r = response(v, u, sine(0.01, 0.4), 10.5, 0.01)
             else:
@@ -202,10 +203,10 @@ class Interface:
         state the vehicle lacks (a preset with fewer units)."""
         kind = variable.source[0]
         if kind == "psi1":
-            return vehicle.n_states
+            return linear_model(vehicle).n_states
         if kind == "Y1":
-            return vehicle.n_states + 1
-        names = vehicle.state_names
+            return linear_model(vehicle).n_states + 1
+        names = linear_model(vehicle).state_names
         return names.index(variable.source[1]) if variable.source[1] in names else -1
 
     def vehicle(self, preset: str | None = None) -> Vehicle:

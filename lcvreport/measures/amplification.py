@@ -25,8 +25,9 @@ import numpy as np
 
 from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ, _freq, steer_to_acceleration
+from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.equations import system_coefficients
 from .registry import MeasureCase
 
 #: single sine: step [s], time after the sine [s], default amplitude [rad]
@@ -90,11 +91,13 @@ class SingleSine:
 
 def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_HZ,
                 delta0_rad: float = SINGLE_SINE_DELTA0_RAD, tire_scale: float = 1.0,
-                step_s: float = SINGLE_SINE_STEP_S, tail_s: float = SINGLE_SINE_TAIL_S) -> SingleSine:
+                step_s: float = SINGLE_SINE_STEP_S, tail_s: float = SINGLE_SINE_TAIL_S,
+                model: str = "yaw_plane") -> SingleSine:
     """The single-sine manoeuvre from rest (SPEC sections 8 and 11): the continuous steer
     ``delta = delta0 sin(2 pi f t)`` for ``0 <= t <= 1/f``, then straight ahead for
     ``tail_s``; the exact response (:func:`lcvreport.analysis.exact.response`), sampled
-    every ``step_s``, its peaks located on the continuous response.
+    every ``step_s``, its peaks located on the continuous response; on the linear model
+    ``model`` (default the yaw plane).
 
     Examples
     --------
@@ -108,7 +111,7 @@ def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_H
     f = float(_freq(f_hz))
     steer = sine(delta0_rad, f)
     t_end = round((1.0 / f + tail_s) / step_s) * step_s
-    r = response(vehicle, speed_mps, steer, t_end, step_s, tire_scale=tire_scale)
+    r = response(vehicle, speed_mps, steer, t_end, step_s, tire_scale=tire_scale, model=model)
     peaks = r.peaks_abs([f"ay{i + 1}" for i in range(vehicle.n_units)])
     return SingleSine(r.time, f, float(delta0_rad), float(speed_mps), vehicle, peaks, r)
 
@@ -205,7 +208,7 @@ def _ra_slope(batch: VariantBatch, speed_mps: float, x_hz: np.ndarray, tire_scal
               rows: np.ndarray) -> np.ndarray:
     """d ln RA / d omega of variant rows[k] at x_hz[k] [Hz] (its sign is that of dRA/df), exact:
     ``dz/dw = -(jwM - S)^-1 jM z``, as the one-variant ``ra_peak``."""
-    co = system_coefficients(batch.vehicle)
+    co = linear_model(batch.vehicle, batch.model)
     c = {k: v[rows] for k, v in batch.coefficients.items()}
     u = float(speed_mps)
     M = c["M0"] + u * c["M1"]

@@ -24,6 +24,7 @@ import numpy as np
 from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ
 from ..analysis.steady import Trim
+from ..model.linear import linear_model
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.loads import load_vector, one_percent_rule
 from ..units import mps_to_kph
@@ -132,7 +133,7 @@ def residual_force(vehicle: Vehicle, load_units=None, sources=None, tire_scale: 
     units = tuple(load_units) if load_units else ()
     if not units and not sources:
         return None
-    F = np.zeros(vehicle.n_states)
+    F = np.zeros(linear_model(vehicle).n_states)
     if units:
         F = F + load_vector(vehicle, one_percent_rule(vehicle, list(units)))
     if sources:

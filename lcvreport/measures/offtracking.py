@@ -29,8 +29,9 @@ from ..analysis.batch import RESPONSE_GROUP, VariantBatch
 from ..analysis.exact import ManoeuvreError, ManoeuvreResponse, check_lane_change_steer, response
 from ..analysis.steady import check_trim, steady_with_yaw_rate, trim
 from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
+from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_speed, check_tire_scale, system_coefficients
+from ..model.yaw_plane.equations import system_coefficients
 from ..model.yaw_plane.outputs import point_lateral_map
 from ..ranges import RANGES
 from .registry import MeasureCase
@@ -64,10 +65,12 @@ class LaneChangeMeasures:
 
 
 def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
-                         accel_g: float = LANE_CHANGE[0], f_hz: float = LANE_CHANGE[1]) -> LaneChangeMeasures:
+                         accel_g: float = LANE_CHANGE[0], f_hz: float = LANE_CHANGE[1],
+                         model: str = "yaw_plane") -> LaneChangeMeasures:
     """The path-following lane change ``lane-change:0.15g:0.4``: the largest overshoot of
     the last unit's rearmost axle beyond the steered axle's final offset A0/(2 pi F^2)
-    over 0 <= t <= 1/F + 8 s (0 if none), and max|a_N| / max|a_s|.
+    over 0 <= t <= 1/F + 8 s (0 if none), and max|a_N| / max|a_s|; on the linear model
+    ``model`` (default the yaw plane).
 
     Raises
     ------
@@ -76,7 +79,7 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
     """
     steer = lane_change(accel_g * G_MPS2, f_hz)
     t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
-    r = response(vehicle, speed_mps, steer, t_end, DT_S, tire_scale=tire_scale)
+    r = response(vehicle, speed_mps, steer, t_end, DT_S, tire_scale=tire_scale, model=model)
     offset = lane_change_offset_m(steer)
     rear = vehicle.units[-1].rearmost_axle.name
     steered = max(vehicle.steered_axles, key=lambda a: a.x_m).name
@@ -181,7 +184,7 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
     co = system_coefficients(vehicle)
     u = float(speed_mps)
     omega = u / radius_m
-    x, delta = steady_with_yaw_rate(vehicle, u, np.zeros(vehicle.n_states), omega, tire_scale)
+    x, delta = steady_with_yaw_rate(vehicle, u, np.zeros(linear_model(vehicle).n_states), omega, tire_scale)
     beta = (co.velocity_map(u) @ x) / u             # CG sideslip of every unit
     d = chain_on_circle(vehicle, beta, radius_m)
 
@@ -215,7 +218,7 @@ def lane_change_batched(batch: VariantBatch, speed_mps: float,
     from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
     from ..model.yaw_plane.outputs import point_lateral_map
     v = batch.vehicle
-    B, nu, n = batch.size, v.n_units, v.n_states
+    B, nu, n = batch.size, v.n_units, linear_model(v).n_states
     accel_g, f_hz = LANE_CHANGE
     steer = lane_change(accel_g * G_MPS2, f_hz)
     t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
@@ -265,8 +268,8 @@ def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
     u = float(speed_mps)
     omega = u / R
     v = batch.vehicle
-    x, delta = batch.steady(u, np.zeros(v.n_states), omega, tire_scale)
-    beta = x @ system_coefficients(v).velocity_map(u).T / u            # (B, N) CG sideslips
+    x, delta = batch.steady(u, np.zeros(linear_model(v).n_states), omega, tire_scale)
+    beta = x @ linear_model(v, batch.model).velocity_map(u).T / u      # (B, N) CG sideslips
     d = chain_on_circle(v, beta, R)                                     # (B, N) the chain on the circle
     steered = max(v.steered_axles, key=lambda a: a.x_m)
     rear = v.units[-1].rearmost_axle

@@ -26,8 +26,8 @@ import numpy as np
 
 from ..analysis.batch import VariantBatch
 from ..analysis.modes import eigenvalues, state_matrix
+from ..model.linear import check_tire_scale
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import check_tire_scale
 from ..ranges import RANGES
 from ..units import kph_to_mps, mps_to_kph
 from .registry import MeasureCase
@@ -44,9 +44,11 @@ U_MIN_DEFAULT_MPS = 2.2352
 CRITICAL_SPEED_RESOLUTION_KPH = 0.1
 
 
-def least_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> tuple[float | None, float | None]:
-    """(least damping ratio [-], its damped frequency [Hz]) over the oscillatory modes; (None, None) if none."""
-    lam = eigenvalues(vehicle, speed_mps, tire_scale)
+def least_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
+                  model: str = "yaw_plane") -> tuple[float | None, float | None]:
+    """(least damping ratio [-], its damped frequency [Hz]) over the oscillatory modes of the
+    linear model ``model``; (None, None) if none."""
+    lam = eigenvalues(vehicle, speed_mps, tire_scale, model)
     osc = lam[lam.imag > 1e-12 * max(np.abs(lam).max(), 1.0)]
     if osc.size == 0:
         return None, None
@@ -56,14 +58,16 @@ def least_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -
 
 
 def critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: float = U_MIN_DEFAULT_MPS,
-                   u_max_kph: float = CRITICAL_SPEED_MAX_KPH) -> float | None:
-    """Lowest speed [km/h] in ``(u_min, u_max]`` where ``max Re(lambda) >= 0``, to 0.1 km/h; None if stable.
+                   u_max_kph: float = CRITICAL_SPEED_MAX_KPH, model: str = "yaw_plane") -> float | None:
+    """Lowest speed [km/h] in ``(u_min, u_max]`` where ``max Re(lambda) >= 0`` (of the linear
+    model ``model``), to 0.1 km/h; None if stable.
 
     ``max Re(lambda)`` is scanned every 4 km/h; every interval whose ends are not
     clearly stable -- closer to 0 than twice the largest change of ``max Re(lambda)``
     over that interval and its neighbours -- is scanned again every 1 km/h; bisection
-    narrows the first unstable speed to 0.01 km/h, rounded to 0.1 km/h.  An instability band narrower than 1 km/h can be missed (none of the
-    vehicles here has one); the result equals a dense scan (tested).
+    narrows the first unstable speed to 0.01 km/h, rounded to 0.1 km/h.  An instability
+    band narrower than 1 km/h can be missed (none of the vehicles here has one); the result
+    equals a dense scan (tested).
 
     Examples
     --------
@@ -75,7 +79,7 @@ def critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: float =
     lo_kph = mps_to_kph(RANGES["u_min"].check(u_min_mps, "u_min"))
 
     def max_real(v_kph):
-        A = state_matrix(vehicle, kph_to_mps(np.asarray(v_kph, dtype=float)), tire_scale)
+        A = state_matrix(vehicle, kph_to_mps(np.asarray(v_kph, dtype=float)), tire_scale, model)
         return np.linalg.eigvals(A).real.max(axis=-1)
 
     coarse = np.linspace(lo_kph, u_max_kph, max(int(math.ceil((u_max_kph - lo_kph) / 4.0)) + 1, 2))

@@ -29,8 +29,8 @@ Examples
 >>> from lcvreport.model.vehicle import Axle, Unit, Vehicle
 >>> ax = Axle("front", 1.5, 2, 2.0e5, 0.0, 0.0, 0.0, steered=True)
 >>> truck = Vehicle("truck", (Unit("truck", 9000.0, 3.0e4, (ax, Axle("rear", -3.5, 4, 1.5e5, 0.0, 0.0, 0.0))),))
->>> truck.state_names
-('v1', 'r1')
+>>> truck.n_units, truck.unit_names, truck.axle_names
+(1, ('truck',), ('front', 'rear'))
 >>> Unit("dolly", 0.0, 1.0, (ax,))
 Traceback (most recent call last):
 ...
@@ -45,7 +45,7 @@ from dataclasses import dataclass, field, replace
 from numbers import Integral, Real
 
 from ..ranges import GYRATION_PER_REACH_MIN, VEHICLE, RangeError
-from .yaw_plane.states import joint_letter, state_names
+from .yaw_plane.states import joint_letter
 
 #: names the vehicle itself may have (it is also the FMU's model name)
 VEHICLE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
@@ -339,11 +339,6 @@ class Vehicle:
         return len(self.units)
 
     @property
-    def n_states(self) -> int:
-        """Number of model states 2N."""
-        return 2 * len(self.units)
-
-    @property
     def unit_names(self) -> tuple[str, ...]:
         """Unit names, front to back."""
         return tuple(u.name for u in self.units)
@@ -367,11 +362,6 @@ class Vehicle:
     def joint_letters(self) -> tuple[str, ...]:
         """Letters of the N-1 joints (A, B, ...)."""
         return tuple(joint_letter(k) for k in range(self.n_units - 1))
-
-    @property
-    def state_names(self) -> tuple[str, ...]:
-        """Names of the state x = [v1, r1..rN, thetaA..]."""
-        return state_names(self.n_units)
 
     @property
     def steered_axles(self) -> tuple[Axle, ...]:

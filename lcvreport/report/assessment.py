@@ -25,6 +25,7 @@ from ..measures.amplification import SingleSine, single_sine
 from ..measures.measure_set import MeasureSet, measure_set
 from ..measures.stability import SpeedSweep, speed_sweep
 from ..model.body import body_extent, unit_poses
+from ..model.linear import linear_model
 from ..model.presets import load_preset
 from ..model.vehicle import Vehicle
 from ..model.vehicle_file import load_vehicle
@@ -235,7 +236,7 @@ class Assessment:
         return yaw_damping_coefficient(self.vehicle, self.speed_mps)
 
     def fig_pulse(self):
-        names = list(self.vehicle.state_names[self.vehicle.n_units + 1:])
+        names = list(linear_model(self.vehicle).state_names[self.vehicle.n_units + 1:])
         y = self.yaw_damping
         fig = fig_pulse(y, names, f"Pulse steer 0.01 rad, 0.5 s: articulation of {self.at} (dots: the "
                                            "extrema the ratio method uses)")

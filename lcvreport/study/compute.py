@@ -24,6 +24,7 @@ from ..analysis.frequency import RA_FREQUENCY_HZ
 from ..measures.measure_set import measure_set
 from ..measures.registry import BATCHED as BATCH_GROUPS
 from ..measures.registry import FAMILIES, MeasureCase
+from ..model.linear import linear_model
 from .spec import BATCHED, Study
 
 
@@ -44,7 +45,7 @@ def compute_chunk(study: Study, case_ids) -> dict:
     groups = [g for g, keys in BATCH_GROUPS.items() if batched & set(keys)]
     F = None
     if "trim" in groups:
-        F = np.full((ids.size, v.n_states), np.nan)           # NaN rows: no source (measure_set's null)
+        F = np.full((ids.size, linear_model(v).n_states), np.nan)           # NaN rows: no source (measure_set's null)
         for k in range(ids.size):
             F[k] = _case_force(study, int(ids[k]))
     if batched:
@@ -78,8 +79,8 @@ def _case_force(study: Study, case_id: int) -> np.ndarray:
     vehicle, _speed, kwargs = study.case(case_id)
     units, sources = kwargs.get("load_units"), kwargs.get("sources")
     if not units and not sources:
-        return np.full(vehicle.n_states, np.nan)
-    F = np.zeros(vehicle.n_states)
+        return np.full(linear_model(vehicle).n_states, np.nan)
+    F = np.zeros(linear_model(vehicle).n_states)
     if units:
         F = F + load_vector(vehicle, one_percent_rule(vehicle, list(units)))
     if sources:

@@ -18,6 +18,7 @@ from scipy.optimize import linear_sum_assignment
 from ..analysis.modal import modal_coefficients
 from ..analysis.modes import eigenvalues
 from ..analysis.steady import steady_state
+from ..model.linear import linear_model
 from ..model.presets import load_preset
 from ..model.yaw_plane.equations import system_matrices
 from ..model.yaw_plane.loads import load_vector, one_percent_rule
@@ -115,7 +116,7 @@ def correlation_values() -> dict:
     for conv in ("thesis", "consistent"):
         F = load_vector(vehicle, one_percent_rule(vehicle, c["loaded_units"]), conv)
         x = steady_state(vehicle, mph_to_mps(c["speed_mph"]), F)
-        out[conv] = float(np.degrees(x[vehicle.state_names.index("thetaC")]))
+        out[conv] = float(np.degrees(x[linear_model(vehicle).state_names.index("thetaC")]))
     return out
 
 

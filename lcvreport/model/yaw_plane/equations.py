@@ -38,14 +38,15 @@ from functools import lru_cache
 
 import numpy as np
 
-from ...ranges import check_array
 from ...units import SI, UnitSystem
-from ...util.numerics import solve_scaled
+from ..linear import LinearModel, check_speed, check_tire_scale
 from ..vehicle import Vehicle
+from .outputs import point_lateral_map
+from .states import state_names
 
 
 @dataclass(frozen=True, eq=False)
-class SystemCoefficients:
+class SystemCoefficients(LinearModel):
     r"""Speed- and tire-scale-free coefficients of the matrices of one vehicle.
 
     ``M(u) = M0 + u*M1``;  ``S(u, s) = s*(S0 + Sinv/u) + Skin + u*Su``;
@@ -92,31 +93,7 @@ class SystemCoefficients:
     B_eps: np.ndarray = None
     B_crossfall: np.ndarray = None
 
-    @property
-    def n_states(self) -> int:
-        """Number of states 2N."""
-        return self.M0.shape[0]
-
-    def _u(self, speed_mps):
-        return self.units.speed(np.asarray(speed_mps, dtype=float))[..., None, None]
-
-    def M(self, speed_mps: float | np.ndarray) -> np.ndarray:
-        """Mass matrix at forward speed [m/s]; broadcasts over arrays of speed."""
-        return self.M0 + self._u(speed_mps) * self.M1
-
-    def S(self, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0) -> np.ndarray:
-        """Stiffness matrix at forward speed [m/s] and tire scale [-]; broadcasts."""
-        u = self._u(speed_mps)
-        s = np.asarray(tire_scale, dtype=float)[..., None, None]
-        return s * (self.S0 + self.Sinv / u) + self.Skin + u * self.Su
-
-    def B_delta(self, tire_scale: float | np.ndarray = 1.0) -> np.ndarray:
-        """Generalized force per radian of steer angle (force and moment units per rad)."""
-        return np.asarray(tire_scale, dtype=float)[..., None] * self.Bdelta
-
-    def input_matrix(self, tire_scale: float = 1.0) -> np.ndarray:
-        """B for ``w = [delta, P_axles..., T_axles...]`` (rad, force unit, moment unit)."""
-        return np.column_stack([self.B_delta(tire_scale), self.B_P, self.B_T])
+    kind = "yaw_plane"
 
     def velocity_map(self, speed_mps: float) -> np.ndarray:
         """``V`` with ``v = V x``: the CG lateral velocity of every unit [length/s] from the
@@ -135,39 +112,39 @@ class SystemCoefficients:
         R[:, :n + 1] = self.Jr
         return R
 
-    def state_derivative_maps(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-        """(A, G) with ``x' = A x + G F``: ``A = M^-1 S``, ``G = M^-1`` (equilibrated solve).
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """``v1, r1..rN, thetaA..`` (joints lettered from the front)."""
+        return state_names(self.vehicle.n_units)
 
-        For one speed and tire scale the result is kept (the last :data:`MAPS_KEPT` pairs,
-        read-only arrays): a measure set asks for the same maps some twenty times."""
-        scalar = np.ndim(speed_mps) == 0 and np.ndim(tire_scale) == 0
-        if scalar:
-            key = (float(speed_mps), float(tire_scale))
-            memo = self.__dict__.setdefault("_maps_memo", {})
-            hit = memo.get(key)
-            if hit is not None:
-                return hit
+    @property
+    def state_units(self) -> tuple[str, ...]:
+        n = self.vehicle.n_units
+        return ("m/s",) + ("rad/s",) * n + ("rad",) * (n - 1)
+
+    def heading_rows(self) -> np.ndarray:
+        """``Theta_k = psi1 - psi_k`` of units 2..N over ``[x, psi1, Y1]``: the sums of the
+        articulation angles ahead of each unit, shape (N-1, n + 2)."""
+        nu, n = self.vehicle.n_units, self.n_states
+        cum = np.zeros((nu - 1, n + 2))
+        for k in range(nu - 1):
+            cum[k, nu + 1:nu + 2 + k] = 1.0
+        return cum
+
+    def point_lateral_map(self, unit: int, x_m: float) -> np.ndarray:
+        """``c`` with the point's global lateral position ``c . [psi1, Y1, Theta_2..Theta_N]`` [m]
+        (first order): :func:`lcvreport.model.yaw_plane.outputs.point_lateral_map`."""
+        return point_lateral_map(self.vehicle, unit, x_m)
+
+    def point_lateral_row(self, unit: int, x_m: float) -> np.ndarray:
+        """The global lateral position [m] of the point at signed x on unit ``unit`` (0-based)
+        over ``[x, psi1, Y1]``, first order, shape (n + 2,)."""
+        c = self.point_lateral_map(unit, x_m)
+        row = c[2:] @ self.heading_rows() if self.vehicle.n_units > 1 else np.zeros(self.n_states + 2)
         n = self.n_states
-        AG = solve_scaled(self.M(speed_mps), np.hstack([self.S(speed_mps, tire_scale), np.eye(n)]))
-        A, G = AG[:, :n], AG[:, n:]
-        if scalar:
-            A.setflags(write=False)
-            G.setflags(write=False)
-            if len(memo) >= MAPS_KEPT:
-                try:                                    # the oldest out (another thread may be at it too)
-                    memo.pop(next(iter(memo)), None)
-                except (RuntimeError, StopIteration):
-                    pass
-            memo[key] = (A, G)
-        return A, G
-
-    def acceleration_maps(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-        """(Ca, Da) with the lateral accelerations of the unit CGs ``a = Ca x + Da F``
-        (SPEC section 8: ``a_i = v_i' + u r_i``), shape (N, 2N) each."""
-        A, G = self.state_derivative_maps(speed_mps, tire_scale)
-        V = self.velocity_map(speed_mps)
-        u = float(self.units.speed(speed_mps))
-        return V @ A + u * self.yaw_rate_map(), V @ G
+        row[n] += c[0]
+        row[n + 1] += c[1]
+        return row
 
 
 def kinematic_jacobians(rear: np.ndarray, front: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -203,10 +180,6 @@ def kinematic_jacobians(rear: np.ndarray, front: np.ndarray) -> tuple[np.ndarray
             K[i, j] = 1.0
         Jv[i, 1 + i] -= front[i]
     return Jv, Jr, K
-
-
-#: (A, G) pairs kept per vehicle by :meth:`SystemCoefficients.state_derivative_maps`
-MAPS_KEPT = 8
 
 
 @lru_cache(maxsize=256)
@@ -294,16 +267,6 @@ def system_coefficients(vehicle: Vehicle, units: UnitSystem = SI) -> SystemCoeff
     for arr in arrays:
         arr.setflags(write=False)
     return SystemCoefficients(vehicle, units, *arrays)
-
-
-def check_speed(speed_mps, name: str = "speed") -> np.ndarray:
-    """Raise :class:`lcvreport.ranges.RangeError` unless every speed [m/s] is in range."""
-    return check_array("speed", speed_mps, name)
-
-
-def check_tire_scale(tire_scale, name: str = "tire_scale") -> np.ndarray:
-    """Raise :class:`lcvreport.ranges.RangeError` unless every tire scale is in range."""
-    return check_array("tire_scale", tire_scale, name)
 
 
 def system_matrices(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0,

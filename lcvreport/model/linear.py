@@ -1,0 +1,178 @@
+r"""The model seam: what the analysis, the measures, the FMUs and the studies need of any linear
+model of a vehicle, and the table of the models there are.
+
+A linear model is ``M(u) x' = S(u, s) x + B w`` at forward speed u and tire scale s, with
+coefficients affine in u and 1/u::
+
+    M(u) = M0 + u M1,   S(u, s) = s (S0 + Sinv / u) + Skin + u Su,   B_delta(s) = s Bdelta
+
+(tire forces scale with s; inertia and kinematic terms do not), the input ``w = [delta,
+P_axles, T_axles]`` (rad, N, N*m) with the misalignment and crossfall columns ``B_eps`` and
+``B_crossfall``, and the maps from the state to every unit's lateral velocity and yaw rate,
+from which the lateral accelerations ``a_i = v_i' + u r_i`` follow.  Its states are named
+with units (:attr:`LinearModel.state_names`, :attr:`LinearModel.state_units`); the first two
+are always unit 1's lateral velocity ``v1`` [m/s] and yaw rate ``r1`` [rad/s], which is all the
+global position (``psi1' = r1``, ``Y1' = v1 + u psi1``) needs.
+
+Models (:data:`MODELS`): ``yaw_plane`` (the thesis model, :mod:`lcvreport.model.yaw_plane`);
+a new linear model is a folder beside it whose builder returns a :class:`LinearModel`, and one
+entry here.  The low-speed kinematic model (:mod:`lcvreport.model.low_speed`) is not linear and
+is a sibling of its own.
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> m = linear_model(load_preset("tractor_semitrailer"))
+>>> m.kind, m.n_states, m.state_names
+('yaw_plane', 4, ('v1', 'r1', 'r2', 'thetaA'))
+>>> m.state_units
+('m/s', 'rad/s', 'rad/s', 'rad')
+>>> linear_model(load_preset("aucnat"), "yaw_plane").M(24.0).shape
+(12, 12)
+"""
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+
+from ..ranges import check_array
+from ..util.numerics import solve_scaled
+
+#: the linear models: name -> "module:builder" (relative to this package); the builder takes
+#: (vehicle, units) and returns a LinearModel
+MODELS = {"yaw_plane": "yaw_plane.equations:system_coefficients"}
+#: the spelling of the command line (``--model yaw-plane``) for each model
+CLI_NAMES = {name: name.replace("_", "-") for name in MODELS}
+#: (A, G) pairs kept per model by :meth:`LinearModel.state_derivative_maps`
+MAPS_KEPT = 8
+
+
+class ModelError(ValueError):
+    """An unknown model name; the message lists the valid ones."""
+
+
+def check_model(name: str) -> str:
+    """``name`` if it is a linear model (``yaw_plane``; the CLI's ``yaw-plane`` too), else
+    :class:`ModelError` naming the valid ones."""
+    key = str(name).replace("-", "_")
+    if key not in MODELS:
+        raise ModelError(f"unknown model {name!r}; valid: {', '.join(CLI_NAMES.values())}")
+    return key
+
+
+def linear_model(vehicle, model: str = "yaw_plane", units=None) -> "LinearModel":
+    """The linear model ``model`` of ``vehicle`` (cached per vehicle by its builder).
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    model : str
+        A key of :data:`MODELS`.
+    units : UnitSystem, optional
+        :data:`lcvreport.units.SI` (default) or :data:`lcvreport.units.THESIS`.
+    """
+    module, _, builder = MODELS[check_model(model)].partition(":")
+    build = getattr(importlib.import_module(f"{__package__}.{module}"), builder)
+    return build(vehicle) if units is None else build(vehicle, units)
+
+
+def check_speed(speed_mps, name: str = "speed") -> np.ndarray:
+    """Raise :class:`lcvreport.ranges.RangeError` unless every speed [m/s] is in range."""
+    return check_array("speed", speed_mps, name)
+
+
+def check_tire_scale(tire_scale, name: str = "tire_scale") -> np.ndarray:
+    """Raise :class:`lcvreport.ranges.RangeError` unless every tire scale is in range."""
+    return check_array("tire_scale", tire_scale, name)
+
+
+class LinearModel:
+    """The interface of a linear model (see the module docstring).  Subclasses are frozen
+    dataclasses holding ``vehicle``, ``units`` and the coefficients ``M0, M1, S0, Sinv, Su, Skin``
+    (n, n), ``Bdelta`` (n,), ``B_P, B_T, B_eps`` (n, n_axles), ``B_crossfall`` (n,), and define
+    :attr:`kind`, :attr:`state_names`, :attr:`state_units`, :meth:`velocity_map`,
+    :meth:`yaw_rate_map` and :meth:`point_lateral_map`."""
+
+    kind = "linear"
+
+    @property
+    def n_states(self) -> int:
+        """Number of states n."""
+        return self.M0.shape[0]
+
+    @property
+    def state_names(self) -> tuple[str, ...]:  # pragma: no cover - every model defines it
+        raise NotImplementedError
+
+    @property
+    def state_units(self) -> tuple[str, ...]:  # pragma: no cover - every model defines it
+        raise NotImplementedError
+
+    def _u(self, speed_mps):
+        return self.units.speed(np.asarray(speed_mps, dtype=float))[..., None, None]
+
+    def M(self, speed_mps: float | np.ndarray) -> np.ndarray:
+        """Mass matrix at forward speed [m/s]; broadcasts over arrays of speed."""
+        return self.M0 + self._u(speed_mps) * self.M1
+
+    def S(self, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0) -> np.ndarray:
+        """Stiffness matrix at forward speed [m/s] and tire scale [-]; broadcasts."""
+        u = self._u(speed_mps)
+        s = np.asarray(tire_scale, dtype=float)[..., None, None]
+        return s * (self.S0 + self.Sinv / u) + self.Skin + u * self.Su
+
+    def B_delta(self, tire_scale: float | np.ndarray = 1.0) -> np.ndarray:
+        """Generalized force per radian of steer angle (force and moment units per rad)."""
+        return np.asarray(tire_scale, dtype=float)[..., None] * self.Bdelta
+
+    def input_matrix(self, tire_scale: float = 1.0) -> np.ndarray:
+        """B for ``w = [delta, P_axles..., T_axles...]`` (rad, force unit, moment unit)."""
+        return np.column_stack([self.B_delta(tire_scale), self.B_P, self.B_T])
+
+    def velocity_map(self, speed_mps: float) -> np.ndarray:  # pragma: no cover - every model defines it
+        """``V`` with ``v = V x``: every unit's lateral velocity from the state, shape (N, n)."""
+        raise NotImplementedError
+
+    def yaw_rate_map(self) -> np.ndarray:  # pragma: no cover - every model defines it
+        """``R`` with ``r = R x``, shape (N, n)."""
+        raise NotImplementedError
+
+    def point_lateral_map(self, unit: int, x_m: float) -> np.ndarray:  # pragma: no cover
+        """The lateral position of the point ``x_m`` [m] of unit ``unit`` (0-based) over
+        ``[psi1, Y1, x]`` (a map of length n + 2)."""
+        raise NotImplementedError
+
+    def state_derivative_maps(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """(A, G) with ``x' = A x + G F``: ``A = M^-1 S``, ``G = M^-1`` (equilibrated solve).
+
+        For one speed and tire scale the result is kept (the last :data:`MAPS_KEPT` pairs,
+        read-only arrays): a measure set asks for the same maps some twenty times."""
+        scalar = np.ndim(speed_mps) == 0 and np.ndim(tire_scale) == 0
+        if scalar:
+            key = (float(speed_mps), float(tire_scale))
+            memo = self.__dict__.setdefault("_maps_memo", {})
+            hit = memo.get(key)
+            if hit is not None:
+                return hit
+        n = self.n_states
+        AG = solve_scaled(self.M(speed_mps), np.hstack([self.S(speed_mps, tire_scale), np.eye(n)]))
+        A, G = AG[:, :n], AG[:, n:]
+        if scalar:
+            A.setflags(write=False)
+            G.setflags(write=False)
+            if len(memo) >= MAPS_KEPT:
+                try:                                    # the oldest out (another thread may be at it too)
+                    memo.pop(next(iter(memo)), None)
+                except (RuntimeError, StopIteration):
+                    pass
+            memo[key] = (A, G)
+        return A, G
+
+    def acceleration_maps(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """(Ca, Da) with the lateral accelerations of the unit CGs ``a = Ca x + Da F``
+        (``a_i = v_i' + u r_i``), shape (N, n) each."""
+        A, G = self.state_derivative_maps(speed_mps, tire_scale)
+        V = self.velocity_map(speed_mps)
+        u = float(self.units.speed(speed_mps))
+        return V @ A + u * self.yaw_rate_map(), V @ G
