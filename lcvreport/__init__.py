@@ -122,7 +122,7 @@ moments [N*m], states ``v1`` [m/s], ``r`` [rad/s], ``theta`` [rad].  Names of
 dimensional numbers carry their unit (``mass_kg``, ``x_m``, ``speed_mps``,
 ``offtracking_m``); the thesis reproduction asks for matrices in the thesis' units
 explicitly (``units=lcvreport.units.THESIS``: in, lbf, s).  Joints are lettered A, B,
-C ... as in thesis Table 3-2 (``thetaA``); the FMUs of SPEC section 9 number them.
+C ... as in thesis Table 3-2 (``thetaA``); the FMUs of a vehicle file number them (docs/fmu.md).
 
 Examples
 --------

@@ -235,3 +235,27 @@ def test_the_cycle_check_finds_a_cycle(tmp_path):
             test_no_import_cycle()
     finally:
         MODULES = saved
+
+
+def test_the_code_cites_pages_a_reader_has():
+    """The package cites ``docs/`` pages (and their sections) instead of a specification or
+    issue numbers a reader of the repository does not have; every page and section it names
+    exists."""
+    import re
+    docs = PACKAGE.parent / "docs"
+
+    def anchors(page):
+        return {re.sub(r"[^a-z0-9 -]", "", line.lstrip("#").strip().lower()).replace(" ", "-")
+                for line in (docs / page).read_text(encoding="utf-8").splitlines() if line.startswith("#")}
+
+    bad = []
+    for module, path in MODULES.items():
+        text = path.read_text(encoding="utf-8")
+        if re.search(r"SPEC (section|erratum|sections|\d)|\bissue #?\d+", text):
+            bad.append((module, "cites the specification or an issue"))
+        for page, anchor in re.findall(r"docs/([a-z_]+\.md)(?:#([a-z0-9-]+))?", text):
+            if not (docs / page).exists():
+                bad.append((module, page))
+            elif anchor and anchor not in anchors(page):
+                bad.append((module, f"{page}#{anchor}"))
+    assert not bad, bad

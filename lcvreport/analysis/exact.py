@@ -1,4 +1,4 @@
-"""Exact response to continuous steer inputs and constant residual sources (SPEC section 11).
+"""Exact response to continuous steer inputs and constant residual sources (docs/manoeuvres.md).
 
 On each piece of the input (:mod:`lcvreport.manoeuvres.steer`) the model, the global
 position (psi1, Y1), the input's generator ``xi' = E xi`` and a constant 1 form one
@@ -43,8 +43,6 @@ from ..model.yaw_plane.outputs import rear_end_weights
 from .discretize import augmented_state_matrix
 from .extrema import _hermite_roots, _quintic, _scan
 
-#: output step of the measures' manoeuvres [s]
-MEASURE_DT_S = 0.002
 
 
 class ManoeuvreError(ValueError):
@@ -248,14 +246,6 @@ def steered_point(vehicle: Vehicle) -> float:
     return max(a.x_m for a in vehicle.steered_axles)
 
 
-def inverse_zeros(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, model: str = "yaw_plane"
-                  ) -> np.ndarray:
-    """Eigenvalues of the inverse system from the steered axle's lateral acceleration to
-    the steer: the zeros of that transfer function [1/s]."""
-    A, b, Cs, Ds = _steer_axle_maps(vehicle, speed_mps, tire_scale, model)
-    return np.linalg.eigvals(A - np.outer(b, Cs) / Ds)
-
-
 def _steer_axle_maps(vehicle, speed_mps, tire_scale, model: str = "yaw_plane"):
     """x' = A x + b delta (+ G F); a_s = Cs x + Ds delta (+ Js G F)."""
     co = linear_model(vehicle, model)
@@ -286,7 +276,8 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
     t_end, dt : float
         End time and output step [s]; ``dt`` must divide ``t_end``.
     F : numpy.ndarray, optional
-        Constant generalized force (2N,), e.g. :func:`lcvreport.model.yaw_plane.loads.residual_vector`.
+        Constant generalized force (n,) of the residual sources, SI: :func:`lcvreport.load_vector` or
+        :meth:`lcvreport.model.yaw_plane.loads.ResidualSources.vector`.
     tire_scale : float
     t_start, state : float, numpy.ndarray, optional
         Start later than 0 from ``state`` = [x, psi1, Y1] at ``t_start`` (a run in

@@ -2,7 +2,7 @@
 
 ``exact``: left and right eigenvectors with ``Y^T M X = I`` and ``g = Y^T F``, exact
 for the non-symmetric M, S.  ``thesis``: the dissertation's eq. 3.21, 3.26-3.32,
-``X_i^T M X_i = 1``, ``g_i = X_i^T F`` -- exact only for symmetric M and S (SPEC
+``X_i^T M X_i = 1``, ``g_i = X_i^T F`` -- exact only for symmetric M and S (docs/thesis.md,
 erratum 3), kept as a labelled reproduction mode.  The thesis' normalization is not
 invariant under a change of units, so the reproduction runs it in the thesis' units
 (``units=THESIS``) as the thesis did.

@@ -95,7 +95,7 @@ class TimeResponse:
 
     @property
     def lateral_acceleration(self) -> np.ndarray:
-        """a_i = v_i' + u r_i of every unit's CG [m/s^2], shape (K, N) (SPEC section 8)."""
+        """a_i = v_i' + u r_i of every unit's CG [m/s^2], shape (K, N) (docs/measures.md)."""
         co = system_coefficients(self.vehicle)
         n2 = linear_model(self.vehicle).n_states
         out = np.empty((self.time.size, self.vehicle.n_units))

@@ -1,4 +1,4 @@
-"""Steady state under constant loads: ``x_ss = -S^-1 F`` (thesis section 4.4, SPEC erratum 4).
+"""Steady state under constant loads: ``x_ss = -S^-1 F`` (thesis section 4.4, docs/thesis.md, erratum 4).
 
 Examples
 --------

@@ -114,18 +114,12 @@ def _cmd_study(args, out: _Out) -> int:
         raise UsageError("arguments --criteria and --no-pdf belong to --report REPORT_DIR")
     if args.report is not None:
         from ..report.publish import OutputFolderError, check_output_folder
-        try:
-            check_output_folder(args.report)
-        except OutputFolderError as exc:
-            raise UsageError(f"argument --report: {exc}") from None
+        _checked("--report", check_output_folder, args.report, OutputFolderError)
         if Path(args.report).resolve() == out_dir.resolve():
             raise UsageError("argument --report: give another folder than --out")
     if args.criteria is not None:
         from ..measures.criteria import CriteriaError, load_criteria
-        try:
-            load_criteria(args.criteria)
-        except CriteriaError as exc:
-            raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
+        _checked(f"--criteria {args.criteria}", load_criteria, args.criteria, CriteriaError)
     csv_path = out_dir / "results.csv"
     if args.csv and (csv_path.exists() or csv_path.is_symlink()):
         raise UsageError(f"argument --csv: {csv_path} exists; lcv never overwrites a file (move it, or omit --csv)")
@@ -179,3 +173,11 @@ def _cmd_study(args, out: _Out) -> int:
                  + (f" ({rate:.0f} cases/s)" if rate else "") + f"; results in {out_dir}"
                  + (f", {csv_path.name}" if args.csv else ""))
     return 0
+
+
+def _checked(option: str, check, value, error) -> None:
+    """``check(value)``; its ``error`` becomes the one line of the argument ``option`` (exit 2)."""
+    try:
+        check(value)
+    except error as exc:
+        raise UsageError(f"argument {option}: {exc}") from None

@@ -15,7 +15,7 @@ Fixed contract (other parts and outside checks call these forms)::
 
 ``UNITS`` is a comma list of unit names of the vehicle; each gets the 1 % rule on its
 axles (P along +y, T = 0.3048 m * P about +z).  ``--convention`` is ``consistent``
-(default) or ``thesis`` (SPEC erratum 1).  JSON units: eigenvalues [1/s]; matrices in
+(default) or ``thesis`` (docs/thesis.md, erratum 1).  JSON units: eigenvalues [1/s]; matrices in
 thesis units (lbf, in, s) for presets and SI for vehicle files unless ``--units`` says
 otherwise; everything else SI.  Every number is checked against
 :data:`lcvreport.ranges.RANGES`.  A bad argument exits with status 2 and one line naming

@@ -99,6 +99,12 @@ def _load_vector(args: argparse.Namespace, vehicle, units=SI) -> np.ndarray:
     return load_vector(vehicle, res, args.convention, units)
 
 
+def _source_force(args: argparse.Namespace, vehicle):
+    """The generalized force [SI] of the residual sources of the options (None if none)."""
+    src = _sources(args, vehicle)
+    return src.vector(vehicle, args.tire_scale) if src else None
+
+
 def _sources(args: argparse.Namespace, vehicle):
     """The residual sources of ``--residual``, ``--misalignment``, ``--crossfall-percent``."""
     from ..model.yaw_plane.loads import ResidualLoads, ResidualSources

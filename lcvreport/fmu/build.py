@@ -1,8 +1,8 @@
 """Build the FMUs: the pythonfmu FMU and the C99 FMU of the presets or of any vehicle.
 
 ``python -m lcvreport.fmu.build --out build`` is what ``./build.sh fmu`` runs: it
-writes ``build/LCV.fmu`` and ``build/LCVNative.fmu`` (SPEC section 5).  ``lcv fmu``
-calls :func:`build_vehicle_fmus` (SPEC section 9): ``<name>.fmu`` and
+writes ``build/LCV.fmu`` and ``build/LCVNative.fmu`` (docs/fmu.md).  ``lcv fmu``
+calls :func:`build_vehicle_fmus` (docs/fmu.md): ``<name>.fmu`` and
 ``<name>Native.fmu`` with the vehicle built in.
 
 Everything is generated from the interface table (:mod:`lcvreport.fmu.interface`):
@@ -81,7 +81,7 @@ def build_native_fmu(itf: Interface, out_dir: Path, model_identifier: str, stub:
 
 def build_native_fmu3(itf: Interface, out_dir: Path, model_identifier: str) -> Path:
     """The FMI 3.0 native FMU ``<model_identifier>.fmu`` (Co-Simulation and Model Exchange),
-    from the same model code as the FMI 2.0 one with fmi3_api.c in front (SPEC section 15)."""
+    from the same model code as the FMI 2.0 one with fmi3_api.c in front (docs/fmu.md)."""
     from .description_fmi3 import FMI3_SOURCE_FILES, build_description3, model_description3
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -201,7 +201,7 @@ class {cls}(_LCV3, Fmi3Slave):
 
 def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env: dict | None = None) -> Path:
     """The FMI 3.0 Python FMU ``<model_identifier>.fmu`` (Co-Simulation, pythonfmu3 0.3.4) with
-    the loader (``loader3.c``) as its binary, so that plain C hosts load it (SPEC section 15)."""
+    the loader (``loader3.c``) as its binary, so that plain C hosts load it (docs/fmu.md)."""
     from .description_fmi3 import model_description3
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -243,8 +243,8 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
 
 
 def build_preset_fmus(out_dir: Path) -> list[Path]:
-    """``LCV.fmu`` and ``LCVNative.fmu`` (SPEC section 5), and their FMI 3.0 siblings ``LCV3.fmu``
-    and ``LCVNative3.fmu`` (SPEC section 15)."""
+    """``LCV.fmu`` and ``LCVNative.fmu`` (docs/fmu.md), and their FMI 3.0 siblings ``LCV3.fmu``
+    and ``LCVNative3.fmu`` (docs/fmu.md)."""
     itf = preset_interface()
     return [build_python_fmu(itf, out_dir, "LCV"), build_native_fmu(itf, out_dir, "LCVNative"),
             build_python_fmu3(itf, out_dir, "LCV3"), build_native_fmu3(itf, out_dir, "LCVNative3")]
@@ -264,9 +264,9 @@ def fmi3_python_name(name: str) -> str:
 
 def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both",
                        u_start_mps: float = U_START, fmi: int = 2) -> list[Path]:
-    """``<name>.fmu`` (pythonfmu) and/or ``<name>Native.fmu`` (C99) of a vehicle (SPEC section 9);
+    """``<name>.fmu`` (pythonfmu) and/or ``<name>Native.fmu`` (C99) of a vehicle (docs/fmu.md);
     with ``fmi=3``, ``<name>3.fmu`` (pythonfmu3; ``<name>_fmi3.fmu`` when the name ends in a digit)
-    and/or ``<name>Native3.fmu`` (SPEC section 15).
+    and/or ``<name>Native3.fmu`` (docs/fmu.md).
 
     Parameters
     ----------

@@ -32,10 +32,6 @@ STUB_SOURCES = ("fmi2_api.c", "fmi2_shared.c", "model_stub.c")
 C_HEADERS = ("fmi2_shared.h", "model.h", "linalg.h", "vehicle.h", "fmi3_no_variables.h")
 
 
-#: the official FMI 2.0 headers (from fmpy's package)
-FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
-
-
 #: name of pythonfmu's export library inside a pythonfmu FMU (the loader loads it)
 EXPORT_LIB = "pythonfmu-export.so"
 

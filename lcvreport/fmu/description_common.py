@@ -94,6 +94,29 @@ def variable_attributes(v: FmuVariable) -> dict:
     return attrs
 
 
+def real_attributes(v: FmuVariable, declared: dict, nominal: dict) -> dict:
+    """The attributes of a real variable's type element (FMI 2.0 ``Real``, FMI 3.0 ``Float64``):
+    declared type, unit, display unit, the range of what the FMU refuses (parameters and
+    inputs, from the ranges table), start and, for a Model Exchange state, its nominal."""
+    attrs = {}
+    if (v.quantity, v.display_unit) in declared:
+        attrs["declaredType"] = declared[(v.quantity, v.display_unit)]
+    if v.unit:
+        attrs["unit"] = v.unit
+    if v.display_unit:
+        attrs["displayUnit"] = v.display_unit
+    if v.causality in ("parameter", "input"):
+        if v.minimum is not None:
+            attrs["min"] = _num(v.minimum)
+        if v.maximum is not None:
+            attrs["max"] = _num(v.maximum)
+    if v.start is not None:
+        attrs["start"] = _num(v.start)
+    if v.name in nominal:                     # a Model Exchange state: its physical scale
+        attrs["nominal"] = _num(nominal[v.name])
+    return attrs
+
+
 def declared_types(itf: Interface) -> dict:
     """(quantity kind, display unit) -> (type name, attributes: quantity, unit, displayUnit) of
     every real variable's declared type."""

@@ -16,10 +16,9 @@ from __future__ import annotations
 
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
-
-from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial_dependencies, _num,
-                                 _state_dependencies, categories_and_experiment, declared_types, enumeration_items,
-                                 enumeration_type_name, enumeration_value, guid, unit_definitions, variable_attributes)
+from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial_dependencies, _state_dependencies,
+                                 categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
+                                 enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
 
 #: the C sources of the native FMU listed in ``<SourceFiles>`` (``fmpy compile`` rebuilds it)
@@ -44,7 +43,7 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
         "description": itf.description + ("" if not native else " Native C implementation: no Python at run time."),
         "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": generation_tool,
         "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
-    if native:                  # Model Exchange from the same model code (SPEC section 15)
+    if native:                  # Model Exchange from the same model code (docs/fmu.md)
         me = SubElement(root, "ModelExchange", {
             "modelIdentifier": model_identifier, "needsExecutionTool": "false",
             "completedIntegratorStepNotNeeded": "true", "canBeInstantiatedOnlyOncePerProcess": "false",
@@ -73,7 +72,7 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
     for name, attrs in declared.values():
         SubElement(SubElement(types, "SimpleType", name=name), "Real", attrs)
     declared = {key: name for key, (name, _attrs) in declared.items()}
-    for v in itf.variables:     # the Enumeration of the presets (SPEC section 15)
+    for v in itf.variables:     # the Enumeration of the presets (docs/fmu.md)
         if v.type == "Enumeration":
             enumeration_items(SubElement(SubElement(types, "SimpleType", name=enumeration_type_name(v),
                                                     description=f"Values of {v.name}"), "Enumeration"), v)
@@ -86,23 +85,7 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
             SubElement(sv, "Enumeration", {"declaredType": enumeration_type_name(v),
                                            "start": str(enumeration_value(v, v.start))})
             continue
-        real = {}
-        if (v.quantity, v.display_unit) in declared:
-            real["declaredType"] = declared[(v.quantity, v.display_unit)]
-        if v.unit:
-            real["unit"] = v.unit
-        if v.display_unit:
-            real["displayUnit"] = v.display_unit
-        if v.causality in ("parameter", "input"):   # what the FMU refuses, from the ranges table
-            if v.minimum is not None:
-                real["min"] = _num(v.minimum)
-            if v.maximum is not None:
-                real["max"] = _num(v.maximum)
-        if v.start is not None:
-            real["start"] = _num(v.start)
-        if v.name in nominal:                     # a Model Exchange state: its physical scale
-            real["nominal"] = _num(nominal[v.name])
-        SubElement(sv, "Real", real)
+        SubElement(sv, "Real", real_attributes(v, declared, nominal))
     index = {v.name: v.value_reference + 1 for v in itf.variables}
     derivatives = []
     if native:                  # der(x) of every continuous state, locals after every variable

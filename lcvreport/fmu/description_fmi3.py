@@ -1,4 +1,4 @@
-"""modelDescription.xml and buildDescription.xml of the FMI 3.0 native FMU (SPEC section 15).
+"""modelDescription.xml and buildDescription.xml of the FMI 3.0 native FMU (docs/fmu.md).
 
 The same interface table, units, types and dependencies as the FMI 2.0 file
 (:mod:`lcvreport.fmu.description_fmi2`), in FMI 3.0's form: ``Float64``/``Enumeration``
@@ -17,9 +17,9 @@ from __future__ import annotations
 
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
-from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial_dependencies, _num,
-                                 _state_dependencies, categories_and_experiment, declared_types, enumeration_items,
-                                 enumeration_type_name, enumeration_value, guid, unit_definitions, variable_attributes)
+from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial_dependencies, _state_dependencies,
+                                 categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
+                                 enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
 
 #: the C sources of the FMI 3.0 native FMU (built with LCV_FMI3 defined)
@@ -76,22 +76,7 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
             SubElement(mv, "Enumeration", {**attrs, "declaredType": enumeration_type_name(v),
                                            "start": str(enumeration_value(v, v.start))})
             continue
-        if (v.quantity, v.display_unit) in declared:
-            attrs["declaredType"] = declared[(v.quantity, v.display_unit)]
-        if v.unit:
-            attrs["unit"] = v.unit
-        if v.display_unit:
-            attrs["displayUnit"] = v.display_unit
-        if v.causality in ("parameter", "input"):
-            if v.minimum is not None:
-                attrs["min"] = _num(v.minimum)
-            if v.maximum is not None:
-                attrs["max"] = _num(v.maximum)
-        if v.start is not None:
-            attrs["start"] = _num(v.start)
-        if v.name in nominal:                     # a Model Exchange state: its physical scale
-            attrs["nominal"] = _num(nominal[v.name])
-        SubElement(mv, "Float64", attrs)
+        SubElement(mv, "Float64", {**attrs, **real_attributes(v, declared, nominal)})
     der_vr = {}
     for k, sv in enumerate(states):
         vr = len(itf.variables) + k

@@ -1,6 +1,6 @@
 """The driver FMU: a path-following driver (FMI 2.0, Co-Simulation and Model Exchange, C99),
 built from ``fmu_src/c/driver.c`` with the start values of
-:data:`lcvreport.manoeuvres.drivers.DEFAULT` (SPEC section 15, the SSP example).
+:data:`lcvreport.manoeuvres.drivers.DEFAULT` (docs/fmu.md, the SSP example).
 
 Examples
 --------

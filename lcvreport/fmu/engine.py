@@ -1,4 +1,4 @@
-"""The co-simulation engine behind the pythonfmu FMUs (SPEC sections 5 and 9), SI, numpy only.
+"""The co-simulation engine behind the pythonfmu FMUs (docs/fmu.md), SI, numpy only.
 
 :class:`LCVEngine` holds one vehicle, its state ``z = [x, psi1, Y1]`` and caches of
 exact zero-order-hold discretizations keyed by (speed, step size) and of the

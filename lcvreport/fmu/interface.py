@@ -9,13 +9,13 @@ output addressing (:mod:`lcvreport.fmu.engine`) are generated from this table,
 the way FMPy's ``ModelVariable`` has one writer and Reference-FMUs' ``config.h``
 one enum.
 
-Two interfaces (SPEC sections 5 and 9):
+Two interfaces (docs/fmu.md):
 
 * :func:`preset_interface`: ``LCV`` / ``LCVNative`` -- a ``preset`` parameter picks one
   of the six thesis vehicles; parameters ``tire_scale``, ``u_min``, ``crossfall``; inputs
   ``P11 .. P61``, ``T11 .. T61``, ``eps11 .. eps61`` of the thesis axles; outputs for six
   units (0 where the preset has fewer), joints lettered ``thetaA .. thetaE``, and ``ay1
-  .. ay6`` after the SPEC section 5 outputs.
+  .. ay6`` after the preset FMU's original outputs (docs/fmu.md).
 * :func:`vehicle_interface`: the vehicle built in; inputs ``P_<axle>``, ``T_<axle>``,
   ``eps_<axle>``; outputs ``v1, r1..rN, theta1..theta(N-1), ay1..ayN, y2..yN, psi1, Y1,
   Y_rear, max_real_eig, Y_<axle>`` (every axle centre's global lateral position).
@@ -52,7 +52,7 @@ PRESET_UNITS = 6
 #: FMI unit name of each quantity kind (SI)
 UNITS = {"speed": "m/s", "angle": "rad", "rate": "rad/s", "force": "N", "moment": "N.m", "length": "m",
          "accel": "m/s2", "per_s": "1/s", "factor": "1", "percent": "%", "none": ""}
-#: display unit of each quantity kind: the preset FMU keeps the thesis' (SPEC section 5),
+#: display unit of each quantity kind: the preset FMU keeps the thesis' (docs/fmu.md),
 #: vehicle FMUs show km/h, degrees and SI
 DISPLAY_UNITS = {
     "thesis": {"speed": "mph", "angle": "deg", "rate": "deg/s", "force": "lbf", "moment": "lbf.ft", "length": "in"},
@@ -77,7 +77,7 @@ class FmuVariable:
     type : {"Real", "Enumeration"}
         ``preset`` is an Enumeration (FMI 2: ``fmi2Get/SetInteger``; FMI 3: ``fmi3Get/SetInt64``)
         whose items are ``items`` numbered from 1; its name is also accepted through
-        ``fmi2SetString``/``fmi3SetString`` (what FMUs before SPEC section 15 took).
+        ``fmi2SetString``/``fmi3SetString`` (what FMUs before the enumeration took).
     quantity : str
         Key of :data:`UNITS` (the FMI unit and display unit follow from it).
     start : float, str or None
@@ -129,7 +129,7 @@ class Interface:
     vehicles : tuple of Vehicle
         The vehicle built in, or the six presets (``preset`` parameter picks one).
     preset_mode : bool
-        True for the SPEC section 5 interface (a ``preset`` String parameter).
+        True for the preset FMUs' interface (a ``preset`` parameter; docs/fmu.md).
     description : str
     """
 
@@ -164,7 +164,7 @@ class Interface:
     @property
     def continuous_states(self) -> tuple[FmuVariable, ...]:
         """The Model Exchange states: the outputs v1, r1..rN, the articulation angles, psi1, Y1
-        (SPEC section 15), in value-reference order."""
+        (docs/fmu.md), in value-reference order."""
         return tuple(v for v in self.outputs if v.source[0] in ("state", "psi1", "Y1"))
 
     def state_nominals(self) -> tuple[float, ...]:
@@ -287,7 +287,7 @@ def preset_value(name: str) -> int:
 
 
 def preset_interface() -> Interface:
-    """The SPEC section 5 interface (``LCV``/``LCVNative``), with ``ay1 .. ay6`` appended."""
+    """The preset FMUs' interface (``LCV``/``LCVNative``, docs/fmu.md), with ``ay1 .. ay6`` appended."""
     from ..model.presets import load_preset
     t = _Table("thesis")
     t.add("preset", "parameter", "fixed", "none", PRESETS[0],
@@ -332,7 +332,7 @@ def preset_interface() -> Interface:
 
 
 def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START) -> Interface:
-    """The SPEC section 9 interface of an FMU with ``vehicle`` built in; the input ``u``
+    """The interface of an FMU with ``vehicle`` built in (docs/fmu.md); the input ``u``
     starts at ``u_start_mps`` [m/s] (default 50 mph)."""
     RANGES["speed"].check(u_start_mps, "start speed")
     t = _Table("si")

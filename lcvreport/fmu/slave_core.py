@@ -5,7 +5,7 @@
 reference; the adapters put it behind pythonfmu (FMI 2.0, :mod:`lcvreport.fmu.slave_fmi2`) and
 pythonfmu3 (FMI 3.0, :mod:`lcvreport.fmu.slave_fmi3`) and say how a message is logged and how the
 FMI functions are spelled.  ``resources/lcv_fmu.json`` says which interface: the six presets
-(SPEC section 5) or one vehicle built in (SPEC section 9).
+(docs/fmu.md) or one vehicle built in (docs/fmu.md).
 
 No exception may leave a callback: pythonfmu turns one into a Fatal status after releasing the
 Python instance, which freeInstance then releases again (a use-after-free that crashes the

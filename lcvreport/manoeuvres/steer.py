@@ -1,4 +1,4 @@
-"""Manoeuvres: steer inputs as continuous functions of time (SPEC section 11).
+"""Manoeuvres: steer inputs as continuous functions of time (docs/manoeuvres.md).
 
 Each steer input is a sequence of :class:`Piece` objects: on ``[t0, t1)`` the input is
 ``h . xi(t)`` with ``xi' = E xi`` -- a constant, a line, a sinusoid -- so that the

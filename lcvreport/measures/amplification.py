@@ -93,7 +93,7 @@ def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_H
                 delta0_rad: float = SINGLE_SINE_DELTA0_RAD, tire_scale: float = 1.0,
                 step_s: float = SINGLE_SINE_STEP_S, tail_s: float = SINGLE_SINE_TAIL_S,
                 model: str = "yaw_plane") -> SingleSine:
-    """The single-sine manoeuvre from rest (SPEC sections 8 and 11): the continuous steer
+    """The single-sine manoeuvre from rest (docs/measures.md, docs/manoeuvres.md): the continuous steer
     ``delta = delta0 sin(2 pi f t)`` for ``0 <= t <= 1/f``, then straight ahead for
     ``tail_s``; the exact response (:func:`lcvreport.analysis.exact.response`), sampled
     every ``step_s``, its peaks located on the continuous response; on the linear model

@@ -1,4 +1,4 @@
-"""Criteria: the user's limits on the measures, and the verdicts (SPEC section 12).
+"""Criteria: the user's limits on the measures, and the verdicts (docs/measures.md).
 
 No limits are built in: a criteria file names the standard and its numbers::
 
@@ -23,13 +23,12 @@ Examples
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..util.files import FileInputError, loads_toml, read_text_file
+from ..util.files import FileInputError, read_toml_file
 from .registry import CRITERIA_KEYS, unknown_key_message
 
 #: keys a limit may name: every scalar measure of the registry (its spelling, as ``lcv measures --json``)
@@ -76,12 +75,8 @@ def load_criteria(path: str | Path) -> Criteria:
         Unreadable file, unknown keys, a limit without min or max, non-finite numbers, no source.
     """
     try:
-        doc = loads_toml(read_text_file(path, "criteria file"))
+        doc = read_toml_file(path, "criteria file")
     except FileInputError as exc:
-        raise CriteriaError(str(exc)) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CriteriaError(f"not valid TOML: {exc}") from None
-    except ValueError as exc:           # an integer beyond Python's digit limit: its line and key
         raise CriteriaError(str(exc)) from None
     unknown = set(doc) - {"limits", "description"}
     if unknown or not isinstance(doc.get("limits"), dict) or not doc["limits"]:

@@ -1,4 +1,4 @@
-"""The low-speed turn and its measures (SPEC section 16, corrected 2026-12), on the kinematic
+"""The low-speed turn and its measures (docs/low_speed_turn.md), on the kinematic
 model of :mod:`lcvreport.model.low_speed`.
 
 The combination runs straight and aligned up to the turn; the **outside wheel of the frontmost
@@ -60,7 +60,7 @@ from .registry import MeasureCase
 
 @functools.lru_cache(maxsize=64)
 def low_speed_measures(vehicle: Vehicle) -> tuple[dict, dict]:
-    """The SPEC section 16 measures of ``vehicle`` (independent of speed and tire scale: cached
+    """The low-speed turn's measures of ``vehicle`` (docs/low_speed_turn.md) (independent of speed and tire scale: cached
     per vehicle) and, for each that is null, why: (values, reasons)."""
     from ..model.body import TurnError
     try:
@@ -115,7 +115,7 @@ def check_turn_geometry(vehicle: Vehicle) -> None:
 
 @dataclass(frozen=True)
 class LowSpeedTurn:
-    """A low-speed turn and its measures [m] (SPEC section 16); a None measure has its reason in
+    """A low-speed turn and its measures [m] (docs/low_speed_turn.md); a None measure has its reason in
     ``undefined``."""
 
     vehicle: Vehicle
@@ -284,12 +284,12 @@ def _extreme(probe: _Probe, value, sign: float, s: np.ndarray, centre: np.ndarra
 
 def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
                    rtol: float = 1e-10, atol: float = 1e-12) -> LowSpeedTurn:
-    """The low-speed turn of ``vehicle`` and its measures (SPEC section 16, corrected 2026-12).
+    """The low-speed turn of ``vehicle`` and its measures (docs/low_speed_turn.md).
 
     Parameters
     ----------
     vehicle : Vehicle
-        With every unit's body keys and every axle's track width (SPEC section 16).
+        With every unit's body keys and every axle's track width (docs/low_speed_turn.md).
     radius_m : float
         Radius of the outside steer wheel's path [m], in (track/2, 100] (the ranges table's
         ``turn_radius``, and more than half the steered axle's track).

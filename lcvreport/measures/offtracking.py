@@ -32,7 +32,6 @@ from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
 from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.equations import system_coefficients
-from ..model.yaw_plane.outputs import point_lateral_map
 from ..ranges import RANGES
 from .registry import MeasureCase
 
@@ -54,7 +53,7 @@ DT_S = 0.002
 
 @dataclass(frozen=True)
 class LaneChangeMeasures:
-    """HSTO and the lane-change RA (SPEC section 12)."""
+    """HSTO and the lane-change RA (docs/measures.md)."""
 
     hsto_m: float
     ra_lane_change: float
@@ -94,7 +93,7 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
 
 @dataclass(frozen=True)
 class SteadyTurn:
-    """The steady turn of HSSO (SPEC section 12, as corrected 2026-12).
+    """The steady turn of HSSO (docs/measures.md#high-speed-steady-state-offtracking).
 
     Attributes
     ----------
@@ -157,7 +156,7 @@ def chain_on_circle(vehicle: Vehicle, beta, radius_m: float) -> np.ndarray:
 
 def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
                 radius_m: float = HSSO_RADIUS_M) -> SteadyTurn:
-    """The steady turn with the tractor's yaw rate u/R (SPEC section 12, corrected 2026-12): the
+    """The steady turn with the tractor's yaw rate u/R (docs/measures.md: the
     steady state of ``M x' = S x + b delta`` with r1 = u/R gives every unit's CG sideslip
     beta_i = v_i/u; every unit turns at Omega = u/R about one centre O, the units' geometry
     chained through their shared couplings (:func:`chain_on_circle`); a point at x on unit i runs
@@ -196,14 +195,6 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
     paths = {a.name: radius(i, a.x_m) for i, a in zip(vehicle.axle_units, vehicle.axles)}
     hsso = radius(vehicle.n_units - 1, rear.x_m) - radius(0, steered.x_m)
     return SteadyTurn(float(hsso), delta, float(radius_m), x, paths, beta, d)
-
-
-def point_path(vehicle: Vehicle, response: ManoeuvreResponse, unit: int, x_m: float) -> np.ndarray:
-    """Global lateral position [m] of any point of any unit in a manoeuvre (first order)."""
-    c = point_lateral_map(vehicle, unit, x_m)
-    Theta = np.column_stack([response[f"Theta{k + 2}"] for k in range(vehicle.n_units - 1)]) \
-        if vehicle.n_units > 1 else np.zeros((response.time.size, 0))
-    return c[0] * response["psi1"] + c[1] * response["Y1"] + Theta @ c[2:]
 
 
 def lane_change_batched(batch: VariantBatch, speed_mps: float,

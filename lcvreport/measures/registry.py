@@ -7,7 +7,8 @@ for one vehicle and over a batch of variants.
 studies accept exactly their keys (one spelling each: the JSON's, with a dot for a nested key
 such as ``trim.offtracking_m``).
 
-Measures computed together (one manoeuvre, one analysis) form a **family**
+The table is the data file ``lcvreport/data/measures.toml``.  Measures computed together (one
+manoeuvre, one analysis) form a **family**
 (:data:`FAMILIES`): its ``scalar`` function maps a :class:`MeasureCase` to the values of its
 keys and the reason of every null; its ``batched`` function gives the family's scalar keys
 over the variants of a :class:`~lcvreport.analysis.batch.VariantBatch`, one array per key, in
@@ -41,6 +42,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+from importlib import resources
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -149,73 +151,19 @@ class Measure:
         return f"docs/measures.md#{self.doc}"
 
 
-#: the families, in the order measure_set computes them
-FAMILIES: dict[str, Family] = {f.name: f for f in (
-    Family("least_damping", "stability:least_damping_family", "stability:least_damping_batched"),
-    Family("critical_speed", "stability:critical_speed_family", "stability:critical_speed_batched"),
-    Family("frequency_response", "amplification:frequency_response_family", "amplification:ra_frequency_batched",
-           needs="steer"),
-    Family("single_sine", "amplification:single_sine_family", "amplification:single_sine_batched", needs="steer"),
-    Family("ra_peak", "amplification:ra_peak_family", "amplification:ra_peak_batched", needs="steer"),
-    Family("yaw_damping", "yaw_damping:yaw_damping_family", "yaw_damping:yaw_damping_family_batched", needs="steer"),
-    Family("lane_change", "offtracking:lane_change_family", "offtracking:lane_change_batched", needs="steer"),
-    Family("steady_turn", "offtracking:steady_turn_family", "offtracking:steady_turn_batched", needs="steer"),
-    Family("low_speed_turn", "low_speed:low_speed_family", None, model="low_speed", needs="geometry"),
-    Family("trim", "offtracking:trim_family", "offtracking:trim_batched", needs="sources"),
-)}
+def _load(text: str) -> tuple[dict, dict]:
+    """(FAMILIES, MEASURES) from the registry's data file."""
+    import tomllib
+    doc = tomllib.loads(text)
+    families = {name: Family(name, **entry) for name, entry in doc["families"].items()}
+    measures = {m["key"]: Measure(**m) for m in doc["measures"]}
+    return families, measures
 
 
-def _m(key, label, unit, definition, doc, **kw) -> Measure:
-    return Measure(key, label, unit, definition, doc, **kw)
-
-
-#: the measures, in the order of ``lcv measures --json``
-MEASURES: dict[str, Measure] = {m.key: m for m in (
-    _m("speed_mps", "speed", "m/s", "the forward speed of every unit", "conditions"),
-    _m("least_damping_ratio", "least damping ratio", "-", "min −Re λ/|λ| over the oscillatory modes",
-       "least-damping-ratio", family="least_damping", limit="min"),
-    _m("least_damped_frequency_hz", "least damped frequency", "Hz", "Im λ/2π of that mode", "least-damping-ratio",
-       family="least_damping"),
-    _m("critical_speed_kph", "critical speed", "km/h", "lowest unstable speed up to 200 km/h (none: stable)",
-       "critical-speed", family="critical_speed", limit="min"),
-    _m("ra_frequency", "rearward amplification, 0.4 Hz", "-", "|G_N| / |G_1| at 0.4 Hz, frequency domain",
-       "rearward-amplification", family="frequency_response", limit="max"),
-    _m("ra_single_sine", "rearward amplification, single sine", "-", "max|a_N| / max|a_1|, 0.4 Hz single sine",
-       "rearward-amplification", family="single_sine", limit="max"),
-    _m("ay_gain_per_unit", "lateral acceleration gain", "m/s²/rad", "|G_i(j2π·0.4 Hz)| of every unit",
-       "rearward-amplification", family="frequency_response", shape="per_unit"),
-    _m("ra_peak", "rearward amplification, peak", "-", "max RA(f) over 0.1-2 Hz", "rearward-amplification",
-       family="ra_peak", limit="max"),
-    _m("ra_peak_frequency_hz", "frequency of the RA peak", "Hz", "where RA(f) is largest", "rearward-amplification",
-       family="ra_peak"),
-    _m("yaw_damping_coefficient", "yaw damping coefficient", "-",
-       "ratio method on the free decay after pulse 0.01 rad 0.5 s, 40 s", "yaw-damping-coefficient",
-       family="yaw_damping", limit="min"),
-    _m("yaw_damping_lower_bound", "yaw damping coefficient, lower bound", "-",
-       "0.6901 when every joint is heavily damped (YDC null), else none", "yaw-damping-coefficient",
-       family="yaw_damping"),
-    _m("hsto_m", "high-speed transient offtracking", "m", "lane change 0.15 g 0.4 Hz, rear axle overshoot",
-       "high-speed-transient-offtracking", family="lane_change", limit="max"),
-    _m("ra_lane_change", "rearward amplification, lane change", "-", "max|a_N| / max|a_s| in that lane change",
-       "high-speed-transient-offtracking", family="lane_change", limit="max"),
-    _m("hsso_m", "high-speed steady-state offtracking", "m",
-       "393 m turn: rear axle path radius − steered axle path radius", "high-speed-steady-state-offtracking",
-       family="steady_turn", limit="max"),
-    _m("steady_turn_delta_rad", "steer angle of the 393 m turn", "rad", "the steady turn of HSSO",
-       "high-speed-steady-state-offtracking", family="steady_turn"),
-    _m("lssp_m", "low-speed swept path (swept width)", "m", "90° turn, outside steer wheel on R 12.5 m",
-       "low-speed-turn", family="low_speed_turn", limit="max"),
-    _m("low_speed_offtracking_m", "low-speed offtracking", "m", "steered axle path radius − last rear axle radius",
-       "low-speed-turn", family="low_speed_turn", limit="max"),
-    _m("max_tail_swing_m", "tail swing, largest", "m", "rear outer corner beyond its approach line",
-       "low-speed-turn", family="low_speed_turn", limit="max"),
-    _m("frontal_swing_m", "frontal swing", "m", "front outer corner outside the outside steer wheel's path",
-       "low-speed-turn", family="low_speed_turn", limit="max"),
-    _m("trim.delta_rad", "trim steer angle", "rad", "the steer holding the tractor straight against the sources",
-       "trimmed-straight-running", family="trim"),
-    _m("trim.offtracking_m", "trimmed offtracking", "m", "rearmost axle path − steered axle path, +y",
-       "trimmed-straight-running", family="trim", limit="max"),
-)}
+#: the families, in the order measure_set computes them, and the measures, in the order of
+#: ``lcv measures --json``: the data file ``lcvreport/data/measures.toml``
+FAMILIES, MEASURES = _load(resources.files(__package__.partition(".")[0]).joinpath(
+    "data", "measures.toml").read_text(encoding="utf-8"))
 
 #: the keys a criteria file or a study may name: every scalar measure (not the speed, a condition)
 CRITERIA_KEYS = tuple(k for k, m in MEASURES.items() if m.shape == "scalar" and m.family is not None)

@@ -40,10 +40,6 @@ CRITICAL_SPEED_MAX_KPH = 200.0
 U_MIN_DEFAULT_MPS = 2.2352
 
 
-#: resolution of the critical speed [km/h]
-CRITICAL_SPEED_RESOLUTION_KPH = 0.1
-
-
 def least_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
                   model: str = "yaw_plane") -> tuple[float | None, float | None]:
     """(least damping ratio [-], its damped frequency [Hz]) over the oscillatory modes of the

@@ -41,7 +41,7 @@ YDC_MAX_AMPLITUDES = 6
 
 #: a joint with fewer than two kept amplitudes decays faster than 1/YDC_MIN_FRACTION per half
 #: cycle: its zeta is at least this (ln 20 / sqrt(pi^2 + ln^2 20) = 0.6901), the YDC's lower bound
-#: when every joint is so (SPEC 12)
+#: when every joint is so (docs/measures.md)
 YDC_HEAVY_ZETA = math.log(1.0 / YDC_MIN_FRACTION) / math.sqrt(math.pi ** 2 + math.log(1.0 / YDC_MIN_FRACTION) ** 2)
 
 
@@ -50,7 +50,7 @@ YDC_DT_S = 0.005
 
 @dataclass(frozen=True)
 class YawDamping:
-    """The ratio-method yaw damping of a pulse steer (SPEC section 12).
+    """The ratio-method yaw damping of a pulse steer (docs/measures.md).
 
     Attributes
     ----------
@@ -90,7 +90,7 @@ def ratio_damping(extrema_values) -> tuple[float | None, np.ndarray]:
     before it are the forced response); from it on, those >= 5 % of it (a smaller one is
     skipped, later ones still count), the first six; the mean over consecutive pairs of kept
     amplitudes of zeta = d / sqrt(pi^2 + d^2), d = ln(P_i/P_(i+1)); None when fewer than two are
-    kept (SPEC 12, corrected 2026-12).  For one damped mode ``exp(sigma t) sin(omega t)`` it is
+    kept (docs/measures.md).  For one damped mode ``exp(sigma t) sin(omega t)`` it is
     exactly -sigma / |lambda|.
 
     Examples

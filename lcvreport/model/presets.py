@@ -5,7 +5,7 @@
 ``tractor_semitrailer`` is the AU-NCAT tractor with trailer 1 (chapter III).  The
 files are SI conversions of the thesis tables (:mod:`lcvreport.thesis.vehicles`)
 with the printed (rounded) masses; ``masses="unrounded"`` gives the masses the
-published matrices imply (SPEC section 3), for aucnat and tractor_semitrailer.
+published matrices imply (docs/thesis.md), for aucnat and tractor_semitrailer.
 
 Examples
 --------

@@ -1,4 +1,4 @@
-"""A vehicle: a chain of rigid units coupled by pin joints, in SI (SPEC section 7).
+"""A vehicle: a chain of rigid units coupled by pin joints, in SI (docs/vehicle_files.md).
 
 Units are numbered from the front (1 = the tractor or truck).  Joint k couples unit
 k to unit k+1; the thesis letters its joints A, B, C ... (Table 3-2) and so does this
@@ -103,7 +103,7 @@ def _name(key: str, value, pattern: re.Pattern, what: str) -> str:
 
 @dataclass(frozen=True)
 class Axle:
-    """One axle: position, tires and per-tire coefficients (SI, SPEC section 7).
+    """One axle: position, tires and per-tire coefficients (SI, docs/vehicle_files.md).
 
     Attributes
     ----------
@@ -127,7 +127,7 @@ class Axle:
         Static vertical load [N]; needed only by the 1 % rule.
     track_width_m : float or None
         Lateral distance between the centres of the outermost tires [m]; needed only by
-        the low-speed turn (SPEC section 16).
+        the low-speed turn (docs/low_speed_turn.md).
     """
 
     name: str
@@ -198,7 +198,7 @@ class Unit:
         the default (the rear coupling, or the rearmost axle on the last unit).
     body_front_m, body_rear_m : float or None
         Signed x of the body's front and rear faces [m] (given together, rear < front);
-        needed only by the low-speed turn and the drawings (SPEC section 16).
+        needed only by the low-speed turn and the drawings (docs/low_speed_turn.md).
     body_width_m : float or None
         Width of the body [m], symmetric about the unit's axis.
     """
@@ -255,7 +255,7 @@ class Unit:
 
 @dataclass(frozen=True)
 class Vehicle:
-    """A chain of N >= 1 units coupled by pin joints, SI (SPEC section 7).
+    """A chain of N >= 1 units coupled by pin joints, SI (docs/vehicle_files.md).
 
     Attributes
     ----------

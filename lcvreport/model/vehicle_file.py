@@ -1,4 +1,4 @@
-"""Vehicle files: the user's own vehicle as TOML in SI units (SPEC section 7).
+"""Vehicle files: the user's own vehicle as TOML in SI units (docs/vehicle_files.md).
 
 ::
 
@@ -226,7 +226,7 @@ def read_vehicle_text(path: str | Path) -> str:
 
 
 def load_vehicle(path: str | Path) -> Vehicle:
-    """Read a vehicle file (TOML, SI units, SPEC section 7).
+    """Read a vehicle file (TOML, SI units, docs/vehicle_files.md).
 
     Parameters
     ----------

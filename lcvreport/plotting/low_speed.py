@@ -12,7 +12,7 @@ from .style import PAGE_WIDTH_IN, PALETTE, SMALL_PT, new_figure
 
 
 def fig_swept_path(turn, title: str, outlines_every_m: float = 2.0) -> Figure:
-    """The low-speed turn seen from above, to scale (SPEC section 16): every unit's outline
+    """The low-speed turn seen from above, to scale (docs/low_speed_turn.md): every unit's outline
     every ``outlines_every_m`` of path, the swept region's envelope within the turn, the
     paths of the outside steer wheel and of the last unit's inside rear wheel, the arc's
     centre and the measures marked [m].  ``turn`` is a

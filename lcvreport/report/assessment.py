@@ -36,7 +36,7 @@ from ..plotting.vehicle import fig_mode_shape, fig_vehicle
 from ..tracking.tires import AxleSensitivity, conicity_sensitivity
 from ..units import kph_to_mps
 
-#: speed range of the root locus and of the damping curve [km/h] (SPEC section 10)
+#: speed range of the root locus and of the damping curve [km/h] (docs/reports.md)
 SWEEP_KPH = (10.0, 130.0)
 #: frequency range of the RA curves [Hz]
 RA_CURVE_HZ = (0.1, 2.0)
@@ -52,7 +52,7 @@ class Assessment:
     fast: bool = False
     source: str = ""
     _cache: dict = field(default_factory=dict, repr=False)
-    sources: object = None          # ResidualSources beyond the 1 % rule (SPEC 11)
+    sources: object = None          # ResidualSources beyond the 1 % rule (docs/manoeuvres.md)
     criteria: object = None         # Criteria to judge the measures by
     tracking: dict | None = None    # {"tires": mounted tires or None, "stats": a tracking-statistics spec or None}
 
@@ -213,7 +213,7 @@ class Assessment:
         return measure_set(self.vehicle, self.speed_mps, load_units=list(self.load_units) or None,
                                     sources=self.sources)
 
-    # ------------------------------------------------------------------ manoeuvres (SPEC 11-12)
+    # ------------------------------------------------------------------ manoeuvres (docs/manoeuvres.md, docs/measures.md)
     @cached_property
     def lane_change(self):
         from ..measures.offtracking import lane_change_measures
@@ -289,7 +289,7 @@ class Assessment:
         fig.lcv_data = self.sensitivity_rows()
         return fig
 
-    # ------------------------------------------------------------------ low-speed turn (SPEC 16)
+    # ------------------------------------------------------------------ low-speed turn (docs/low_speed_turn.md)
     @cached_property
     def low_speed_turn(self):
         """:class:`lcvreport.measures.low_speed.LowSpeedTurn`, or the reason it is not computed (str)."""
@@ -306,7 +306,7 @@ class Assessment:
     def fig_swept_path(self):
         return self.low_speed_turn.plot(f"{self.vehicle.name}: low-speed 90° turn, outside steer wheel on R = 12.5 m")
 
-    # ------------------------------------------------------------------ straight-line tracking (SPEC 13)
+    # ------------------------------------------------------------------ straight-line tracking (docs/tracking.md)
     def _tire_force(self) -> np.ndarray:
         """The generalized force of the mounted tires alone (SI)."""
         from ..model.yaw_plane.loads import ResidualSources

@@ -107,7 +107,7 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
                      source: str = "", vehicle_text: str | None = None, paper: str = "letter",
                      residuals: dict | None = None, criteria_file: str | None = None,
                      tracking: dict | None = None) -> dict:
-    """The assessment report of ``vehicle`` (SPEC section 10) into ``out_dir``.
+    """The assessment report of ``vehicle`` (docs/reports.md) into ``out_dir``.
 
     The report is written into a hidden folder beside ``out_dir`` and moved into place
     whole when it is complete; ``out_dir`` must be new, empty or an earlier report
@@ -142,7 +142,7 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
     criteria_file : str, optional
         Limits to judge the measures by (a verdict table).
     tracking : dict, optional
-        Straight-line tracking (SPEC 13): ``tires`` (mounted tires, as
+        Straight-line tracking (docs/tracking.md): ``tires`` (mounted tires, as
         :func:`lcvreport.tracking.tires.read_mounted_tires` returns them) and/or ``stats``
         (a tire population, :func:`lcvreport.tracking.statistics.parse_stats_spec`).
 
@@ -151,42 +151,59 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
     dict
         ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
     """
-    import os
-    from importlib.metadata import version
-
     from ..model.vehicle_file import dumps_vehicle
-    __version__ = version("lcvreport")
+    version, progress = _start(paper, progress)
+    speed_kph = DEFAULT_SPEED_KPH if speed_mps is None else speed_mps / MPS_PER_KPH
+
+    def params_of(staged: Path) -> dict:
+        vehicle_file = staged / "vehicle.toml"
+        text = vehicle_text if vehicle_text is not None else \
+            dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name}).")
+        vehicle_file.write_text(text, encoding="utf-8")
+        return {"preset": None, "vehicle_file": str(vehicle_file), "source": source or None,
+                "speed_kph": float(speed_kph), "residuals": residuals,
+                "criteria_file": None if criteria_file is None else str(Path(criteria_file).resolve()),
+                "load_units": list(load_units) if load_units else None, "tracking": tracking}
+
+    title = f"Yaw-plane assessment of {vehicle.name} at {speed_kph:g} km/h"
+    intro = (f"Linear yaw-plane model of *{md_text(vehicle.name)}* ({vehicle.n_units} units: "
+             f"{md_text(', '.join(vehicle.unit_names))}){' from ' + md_text(source) if source else ''}, assessed "
+             f"at {speed_kph:g} km/h (SI units; speeds in km/h). Written by lcvreport {version} on {{stamp}}.")
+    return _one_notebook(out_dir, "assessment", params_of, title, intro, pdf, paper,
+                         f"lcvreport {version} assessment of {vehicle.name}", f"lcvreport {version} (lcv report)",
+                         progress, fast)
+
+
+def _start(paper: str, progress) -> tuple[str, Callable[[str], None]]:
+    """The package's version and the progress callback, once the paper size is checked."""
+    from importlib.metadata import version
     if paper not in PAPERS:
         raise OutputFolderError(f"paper must be one of {', '.join(PAPERS)}, got {paper!r}")
-    progress = progress or (lambda _text: None)
+    return version("lcvreport"), progress or (lambda _text: None)
+
+
+def _one_notebook(out_dir, stem: str, params_of, title: str, intro: str, pdf: bool, paper: str, pdf_title: str,
+                  written_by: str, progress, fast: bool) -> dict:
+    """A one-notebook report: ``out_dir`` checked, the report written aside -- its ``data/``,
+    the notebook ``stem`` executed with ``fast``, ``data_dir`` and ``params_of(staged)``,
+    merged under ``title`` and ``intro`` (``{stamp}``: the date), exported -- and published
+    into ``out_dir`` whole; nothing left behind on a failure or an interruption."""
+    import os
     out = check_output_folder(out_dir)
     before = _folder_state(out)
     staged = _stage(out)
     try:
         data_dir = staged / "data"
         data_dir.mkdir()
-        speed_kph = DEFAULT_SPEED_KPH if speed_mps is None else speed_mps / MPS_PER_KPH
-        vehicle_file = staged / "vehicle.toml"
-        text = vehicle_text if vehicle_text is not None else \
-            dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name}).")
-        vehicle_file.write_text(text, encoding="utf-8")
-        params = {"fast": bool(fast), "data_dir": str(data_dir), "preset": None, "vehicle_file": str(vehicle_file),
-                  "source": source or None, "speed_kph": float(speed_kph), "residuals": residuals,
-                  "criteria_file": None if criteria_file is None else str(Path(criteria_file).resolve()),
-                  "load_units": list(load_units) if load_units else None, "tracking": tracking}
+        params = {"fast": bool(fast), "data_dir": str(data_dir), **params_of(staged)}
         t0 = time.perf_counter()
         nb_dir = staged / "notebooks"
         nb_dir.mkdir()
-        path = execute("assessment", nb_dir, params)
-        progress(f"notebook assessment: {time.perf_counter() - t0:.1f} s")
-        title = f"Yaw-plane assessment of {vehicle.name} at {speed_kph:g} km/h"
+        path = execute(stem, nb_dir, params)
+        progress(f"notebook {stem}: {time.perf_counter() - t0:.1f} s")
         stamp = time.strftime("%Y-%m-%d", time.gmtime(int(os.environ.get("SOURCE_DATE_EPOCH", time.time()))))
-        intro = (f"Linear yaw-plane model of *{md_text(vehicle.name)}* ({vehicle.n_units} units: "
-                 f"{md_text(', '.join(vehicle.unit_names))}){' from ' + md_text(source) if source else ''}, assessed "
-                 f"at {speed_kph:g} km/h (SI units; speeds in km/h). Written by lcvreport {__version__} on {stamp}.")
-        written = _finish_single(staged, out, before, ("assessment", "assessment", title, path), title, intro,
-                                 pdf, f"lcvreport {__version__} assessment of {vehicle.name}", paper,
-                                 f"lcvreport {__version__} (lcv report)", progress)
+        written = _finish_single(staged, out, before, (stem, stem, title, path), title,
+                                 intro.replace("{stamp}", stamp), pdf, pdf_title, paper, written_by, progress)
     except BaseException as exc:
         _discard(staged, isinstance(exc, KeyboardInterrupt))
         raise
@@ -228,48 +245,24 @@ def build_study_report(study_dir, out_dir, criteria_file: str | None = None, pdf
     dict
         ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
     """
-    import os
-    from importlib.metadata import version
-
     from ..study.results import read_study, stored_study
     from ..study.spec import StudyError
-    __version__ = version("lcvreport")
-    if paper not in PAPERS:
-        raise OutputFolderError(f"paper must be one of {', '.join(PAPERS)}, got {paper!r}")
-    progress = progress or (lambda _text: None)
+    version, progress = _start(paper, progress)
     study_dir = Path(study_dir).resolve()
     try:
         study = stored_study(study_dir)
         read_study(study_dir)                     # complete, readable: before anything is written
     except StudyError as exc:
         raise ReportError(str(exc)) from None
-    out = check_output_folder(out_dir)
-    before = _folder_state(out)
-    staged = _stage(out)
-    try:
-        data_dir = staged / "data"
-        data_dir.mkdir()
-        params = {"fast": bool(fast), "data_dir": str(data_dir), "study_dir": str(study_dir),
-                  "criteria_file": None if criteria_file is None else str(Path(criteria_file).resolve())}
-        t0 = time.perf_counter()
-        nb_dir = staged / "notebooks"
-        nb_dir.mkdir()
-        path = execute("study", nb_dir, params)
-        progress(f"notebook study: {time.perf_counter() - t0:.1f} s")
-        title = f"Study of {study.vehicle.name}: {study.n_cases} cases"
-        stamp = time.strftime("%Y-%m-%d", time.gmtime(int(os.environ.get("SOURCE_DATE_EPOCH", time.time()))))
-        intro = (f"The results of `lcv study` in {md_text(study_dir.name)}: {study.n_cases} cases of "
-                 f"*{md_text(study.vehicle.name)}*, measures {md_text(', '.join(study.measures))} (SI units; speeds "
-                 f"in km/h). Written by lcvreport {__version__} on {stamp}.")
-        written = _finish_single(staged, out, before, ("study", "study", title, path), title, intro, pdf,
-                                 f"lcvreport {__version__} study of {study.vehicle.name}", paper,
-                                 f"lcvreport {__version__} (lcv study --report)", progress)
-    except BaseException as exc:
-        _discard(staged, isinstance(exc, KeyboardInterrupt))
-        raise
-    res = {key: out / name for key, name in written.items()}
-    res["seconds"] = time.perf_counter() - t0
-    return res
+    params = {"study_dir": str(study_dir),
+              "criteria_file": None if criteria_file is None else str(Path(criteria_file).resolve())}
+    title = f"Study of {study.vehicle.name}: {study.n_cases} cases"
+    intro = (f"The results of `lcv study` in {md_text(study_dir.name)}: {study.n_cases} cases of "
+             f"*{md_text(study.vehicle.name)}*, measures {md_text(', '.join(study.measures))} (SI units; speeds "
+             f"in km/h). Written by lcvreport {version} on {{stamp}}.")
+    return _one_notebook(out_dir, "study", lambda _staged: params, title, intro, pdf, paper,
+                         f"lcvreport {version} study of {study.vehicle.name}",
+                         f"lcvreport {version} (lcv study --report)", progress, fast)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -361,6 +361,3 @@ def show_table(number: str, caption: str, rows: list[dict], data_dir: str | Path
     display(Table(number, caption, rows, digits, columns))
 
 
-def matrix_rows(matrix, row_names: list[str], col_names: list[str]) -> list[dict]:
-    """Rows of a matrix for :func:`show_table` (first column the row name)."""
-    return [{"row": rn, **{cn: float(v) for cn, v in zip(col_names, row)}} for rn, row in zip(row_names, matrix)]

@@ -1,4 +1,4 @@
-"""Studies at scale (SPEC section 14): a study file's cases, computed in batches on Dask,
+"""Studies at scale (docs/studies.md): a study file's cases, computed in batches on Dask,
 written as Parquet chunks; read back as one table.
 
 ``spec``     the study file: base vehicle, factors, design, measures; the cases

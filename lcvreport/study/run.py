@@ -1,5 +1,5 @@
 """``lcv study``: a study's chunks on a Dask scheduler, each written as a Parquet file when it
-finishes (SPEC section 14).
+finishes (docs/studies.md).
 
 The output folder holds ``study.json`` (the study as run: its vehicle as vehicle-file text,
 factors, design, measures, chunk size), ``manifest.json`` (its digest, the number of cases and

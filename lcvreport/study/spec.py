@@ -1,4 +1,4 @@
-"""A study file: the base vehicle, the factors, the design, the measures (SPEC section 14).
+"""A study file: the base vehicle, the factors, the design, the measures (docs/studies.md).
 
 A study is a TOML file::
 
@@ -20,7 +20,7 @@ tire coefficient), scale factors ``<unit>.mass_scale``, ``<unit>.yaw_inertia_sca
 ``<unit or axle>.cornering_stiffness_scale`` / ``.aligning_stiffness_scale`` /
 ``.longitudinal_stiffness_scale`` (a unit name scales all its axles); load cases ``load_units``
 (values: lists of units carrying the 1 % rule, ``[]`` for none); residual sources ``P_<axle>_N``,
-``T_<axle>_Nm``, ``eps_<axle>_rad`` (misalignment) and ``crossfall_percent`` (SPEC section 11;
+``T_<axle>_Nm``, ``eps_<axle>_rad`` (misalignment) and ``crossfall_percent`` (docs/manoeuvres.md;
 they act on the trim measures ``trim.delta_rad`` and ``trim.offtracking_m``).  A factor has ``values``
 (a grid, or in a random design drawn with equal chance), or a ``distribution``: ``uniform``
 (``low``, ``high``) or ``normal`` (``mean``, ``sd``).  Cases are numbered from 0 in design order:
@@ -41,7 +41,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -306,7 +305,7 @@ class Study:
         return replace(v, units=tuple(units)), float(self.speeds_mps(table)[0]), kwargs
 
     def sources(self, table: dict, k: int):
-        """The residual sources (SPEC section 11) of row ``k`` of ``table``: a
+        """The residual sources (docs/manoeuvres.md) of row ``k`` of ``table``: a
         :class:`~lcvreport.model.yaw_plane.loads.ResidualSources` (empty when the study has none)."""
         from ..model.yaw_plane.loads import ResidualLoads, ResidualSources
         P, T, eps, cross = {}, {}, {}, 0.0
@@ -525,16 +524,12 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
 
 def load_study(path) -> Study:
     """Read and check a study file (TOML)."""
-    from ..util.files import FileInputError, loads_toml, read_text_file
+    from ..util.files import FileInputError, read_toml_file
     path = Path(path)
     try:
-        doc = loads_toml(read_text_file(path, "study file"))
+        doc = read_toml_file(path, "study file")
     except FileInputError as exc:
         raise StudyError(str(exc)) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"study file {path} is not valid TOML: {exc}") from None
-    except ValueError as exc:          # an integer beyond Python's digit limit: its line and key
-        raise StudyError(f"study file {path}: {exc}") from None
     return study_from_dict(doc, path.parent)
 
 

@@ -1,7 +1,7 @@
 """The audit of the published numbers: recomputed value, deviation, verdict, reason.
 
 Every entry compares a number printed in the thesis (``data/published.toml``) with the
-model of SPEC section 2; tolerances are those of SPEC section 3.  Verdicts:
+model of docs/model.md; tolerances are those of docs/thesis.md.  Verdicts:
 
 ``holds``          within the tolerance (reason says with which masses/convention)
 ``holds only as published``  reproduced only with the thesis' unit error

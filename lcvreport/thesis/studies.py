@@ -37,7 +37,7 @@ from ..units import SI, THESIS, UnitSystem, m_to_in, mph_to_mps
 
 #: the thesis' end time, called steady state in chapter V [s]
 THESIS_END_TIME = 1.0
-#: end time of the corrected reading [s] (SPEC erratum 4: at least 10 s)
+#: end time of the corrected reading [s] (docs/thesis.md, erratum 4: at least 10 s)
 CORRECTED_END_TIME = 10.0
 
 

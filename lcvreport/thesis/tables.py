@@ -55,7 +55,7 @@ def gaps() -> dict[str, Any]:
 
 
 def published() -> dict[str, Any]:
-    """Numbers printed in the thesis and their SPEC tolerances (``published.toml``)."""
+    """Numbers printed in the thesis and their published tolerances (``published.toml``)."""
     return load_table_file("published")
 
 

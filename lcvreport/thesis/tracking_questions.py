@@ -1,4 +1,4 @@
-"""The thesis' open questions on straight-line tracking, answered on AU-NCAT (SPEC 13).
+"""The thesis' open questions on straight-line tracking, answered on AU-NCAT (docs/tracking.md).
 
 The dissertation stops at one deterministic load, 1 % of the axle load, and names what it
 could not answer (sections 4.5, 5.5 and chapter VI): the real range of conicity and ply
@@ -125,11 +125,12 @@ def log10_gaussian_exceedance(mean_m: float, sd_m: float, margin_m: float) -> fl
 
 @dataclass(frozen=True)
 class OnePercentAnswer:
-    """The 1 % rule beside the population (trimmed offtracking [m], trim steer [rad])."""
+    """The 1 % rule beside the population (trimmed offtracking [m], trim steer [rad]): the
+    population, its statistics, and a row per load case of the rule."""
 
-    rule_rows: list
-    stats: TrackingStats
     population: Population
+    stats: TrackingStats
+    rule_rows: list
 
     def rows(self) -> list[dict]:
         s = self.stats
@@ -159,7 +160,7 @@ def one_percent_against_population(draws: int = 1_000_000) -> OnePercentAnswer:
         rows.append({"case": label, "offtracking_m": off, "offtracking_in": m_to_in(off),
                      "sd_from_population_mean": (off - s.offtracking_mean_m) / s.offtracking_sd_m,
                      "share_of_margin": abs(off) / s.margin_m})
-    return OnePercentAnswer(rows, s, pop)
+    return OnePercentAnswer(population=pop, stats=s, rule_rows=rows)
 
 
 @dataclass(frozen=True)

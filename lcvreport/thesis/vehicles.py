@@ -1,7 +1,7 @@
 """The six thesis vehicles, converted from Appendices B-D to SI vehicle files.
 
 The presets ship as vehicle files (``lcvreport/data/vehicles/<preset>.toml``, the
-format of SPEC section 7); this module is where they come from: the thesis tables
+format of docs/vehicle_files.md); this module is where they come from: the thesis tables
 (in, lbf, lbf*s^2/in, lbf*in*s^2, per-tire coefficients) with the gaps of
 ``gaps.toml`` filled, converted to SI, axles named as in the thesis (``11`` is the
 tractor steer axle, ``12``/``13`` the drive tandem, ``21`` the trailer 1 axle ...).

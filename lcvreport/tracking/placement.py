@@ -1,4 +1,4 @@
-"""Tire placement: which measured tire goes where, serial side out or in (SPEC section 13).
+"""Tire placement: which measured tire goes where, serial side out or in (docs/tracking.md).
 
 Given measured tires (conicity and ply steer forces, optionally moments) and the tire
 positions to fill, find the plan -- a tire and a serial side for every position -- that
@@ -69,7 +69,7 @@ OPTIONAL = ("conicity_moment_Nm", "ply_steer_moment_Nm")
 
 @dataclass(frozen=True)
 class Placement:
-    """A mounting plan and how it compares (SPEC section 13).
+    """A mounting plan and how it compares (docs/tracking.md).
 
     Attributes
     ----------
@@ -98,7 +98,7 @@ class Placement:
     seed: int = SEED
 
     def to_dict(self) -> dict:
-        """The JSON of ``lcv tracking place`` (SPEC section 13)."""
+        """The JSON of ``lcv tracking place`` (docs/tracking.md)."""
         r = self.random_offtracking_m
         return {"plan": [dict(row) for row in self.plan], "offtracking_m": self.offtracking_m,
                 "trim_delta_rad": self.trim_delta_rad, "lower_bound_m": self.lower_bound_m,

@@ -92,7 +92,7 @@ def parse_distribution(text: str, what: str) -> Distribution:
 
 @dataclass(frozen=True)
 class TrackingStats:
-    """Trimmed offtracking and trim steer over a tire population (SPEC section 13)."""
+    """Trimmed offtracking and trim steer over a tire population (docs/tracking.md)."""
 
     offtracking_mean_m: float
     offtracking_sd_m: float

@@ -201,3 +201,30 @@ def loads_toml(text: str) -> dict:
         digits = len(m.group(0).replace("_", ""))
         raise TomlNumberError(f"line {line_no}: {key.group(1) if key else 'a value'} is an integer of {digits} "
                               "digits; a number here has a physical size") from None
+
+
+def read_toml_file(path: str | Path, what: str = "file", max_bytes: int = MAX_BYTES) -> dict:
+    """A user's TOML file through :func:`read_text_file` and :func:`loads_toml`: every refusal
+    -- the file itself, its TOML, an integer of thousands of digits -- one
+    :class:`FileInputError` naming ``what`` and the file.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> with tempfile.NamedTemporaryFile("w", suffix=".toml", delete=False) as f:
+    ...     _ = f.write("speed_kph = [")
+    >>> try:
+    ...     read_toml_file(f.name, "study file")
+    ... except FileInputError as exc:
+    ...     print(str(exc).split(":")[0].endswith("is not valid TOML"))
+    True
+    >>> os.unlink(f.name)
+    """
+    import tomllib
+    text = read_text_file(path, what, max_bytes)
+    try:
+        return loads_toml(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise FileInputError(f"{what} {path} is not valid TOML: {exc}") from None
+    except TomlNumberError as exc:
+        raise FileInputError(f"{what} {path}: {exc}") from None

@@ -1,4 +1,4 @@
-"""BLAS threads at the entry points: one by default (SPEC section 14, issue 21).
+"""BLAS threads at the entry points: one by default (docs/studies.md).
 
 On the 12x12 matrices of this model a second BLAS thread buys nothing when the machine is
 idle and costs several times when the other core is busy (measured: ``measure_set`` 3.3x,

@@ -1,4 +1,4 @@
-r"""Low-speed kinematics of a combination: plane motion at walking pace, no inertia (SPEC section 16).
+r"""Low-speed kinematics of a combination: plane motion at walking pace, no inertia (docs/low_speed_turn.md).
 
 A second model beside the linear yaw-plane one: angles of any size, no speed, no mass.
 

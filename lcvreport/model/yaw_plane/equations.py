@@ -1,11 +1,11 @@
 r"""The linear yaw-plane model of any chain of units in the thesis form M x' = S x + F.
 
-State (SPEC section 2): ``x = [v1, r1..rN, thetaA..]`` with ``theta_k = psi_k - psi_(k+1)``.
+State (docs/model.md): ``x = [v1, r1..rN, thetaA..]`` with ``theta_k = psi_k - psi_(k+1)``.
 The equations are written with the principle of virtual power in the generalized
 speeds ``q = (v1, r1..rN)``; this eliminates the joint forces exactly as the thesis
 does by hand (eq. 3.14-3.18, Appendix E), for any number of units.
 
-Kinematics (joint constraint, eq. 3.3/4.7, signed couplings of SPEC section 7)::
+Kinematics (joint constraint, eq. 3.3/4.7, signed couplings of docs/vehicle_files.md)::
 
     v_(k+1) = v_k + rc_k r_k - fc_(k+1) r_(k+1) + u theta_k
 
@@ -67,7 +67,7 @@ class SystemCoefficients(LinearModel):
         Generalized force per moment unit of residual aligning moment T (about +z), per axle.
     B_eps : numpy.ndarray, shape (2N, n_axles)
         Generalized force per radian of misalignment (thrust angle) of each axle at tire
-        scale 1: the axle's slip angle gains +eps (SPEC section 11).
+        scale 1: the axle's slip angle gains +eps (docs/manoeuvres.md).
     B_crossfall : numpy.ndarray, shape (2N,)
         Generalized force per unit of sin(atan(crossfall)): m_i g at every unit's CG, along +y.
     Jv, Jr : numpy.ndarray, shape (N, N+1)
@@ -159,13 +159,10 @@ def kinematic_jacobians(rear: np.ndarray, front: np.ndarray) -> tuple[np.ndarray
 
     Returns
     -------
-    B_eps : numpy.ndarray, shape (2N, n_axles)
-        Generalized force per radian of misalignment (thrust angle) of each axle at tire
-        scale 1: the axle's slip angle gains +eps (SPEC section 11).
-    B_crossfall : numpy.ndarray, shape (2N,)
-        Generalized force per unit of sin(atan(crossfall)): m_i g at every unit's CG, along +y.
     Jv, Jr : numpy.ndarray, shape (N, N+1)
+        Lateral velocity and yaw rate of every unit per generalized speed (v1, r1..rN).
     K : numpy.ndarray, shape (N, N-1)
+        d v_i / d (u theta_k): 1 for every joint ahead of unit i.
     """
     n = rear.size
     Jv = np.zeros((n, n + 1))

@@ -1,11 +1,11 @@
 r"""Residual tire loads: conicity and ply steer as per-axle P and T (SI).
 
 * ``P`` [N] acts along +y at the axle, ``T`` [N*m] about +z (nose-right positive).
-* The 1 % rule (thesis section 3.6, SPEC section 7): P = 1 % of the static axle
+* The 1 % rule (thesis section 3.6, docs/vehicle_files.md): P = 1 % of the static axle
   load along +y and T = 0.3048 m * P about +z -- the thesis' "T = 1 % of the axle
   load in lbf*ft" in consistent units.
 * Two conventions for turning P, T into the generalized force F of M x' = S x + F
-  (SPEC section 4, erratum 1):
+  (docs/thesis.md, erratum 1):
 
   ``consistent``
       every row in the units of M and S.
@@ -35,7 +35,7 @@ from ...units import IN_PER_FT, M_PER_FT, SI, UnitSystem
 from ..vehicle import Vehicle
 from .equations import system_coefficients
 
-#: load conventions (SPEC section 4)
+#: load conventions (docs/thesis.md)
 CONVENTIONS = ("consistent", "thesis")
 #: the thesis' residual load fraction of the vertical axle load
 ONE_PERCENT = 0.01
@@ -174,7 +174,7 @@ def load_vector(vehicle: Vehicle, loads: ResidualLoads, convention: str = "consi
 
 @dataclass(frozen=True)
 class ResidualSources:
-    """Every constant residual source of SPEC section 11, SI.
+    """Every constant residual source of docs/manoeuvres.md, SI.
 
     Attributes
     ----------
