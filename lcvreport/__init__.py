@@ -26,6 +26,9 @@ Where things live (a folder is a layer; each imports only the ones above it)
         ``states``       the state names and the joint letters
         ``outputs``      point and rear-end lateral positions (eq. 4.42-4.46)
         ``loads``        residual loads P, T and their sources; the 1 % rule; load conventions
+    ``yaw_roll/``        the linear yaw-roll model (docs/roll.md), a second LinearModel:
+        ``parameters``   the roll data checked, sprung masses, coupling loads, roll-coupled groups
+        ``equations``    M, S and the input matrices with roll rates and roll angles; load transfer outputs
     ``low_speed/``       the low-speed kinematic model:
         ``kinematics``   pull points, the heading law, the integration along a path (scipy)
 ``manoeuvres/``          **what the driver and the road do**, independent of any model:
@@ -40,6 +43,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``low_speed``        the swept path of the low-speed turn
     ``tracking``         offtracking histogram, axle sensitivities, mounting study
     ``study``            scatter and pass rates of a study
+    ``roll``             the a_y - phi curve of the static rollover threshold
     ``charts``           grouped bars and fitted curves
 ``analysis/``            **linear analysis** (numpy, scipy):
     ``modes``            eigenvalues, damping, mode shapes
@@ -60,6 +64,8 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``yaw_damping``      yaw damping coefficient (ratio method)
     ``offtracking``      HSTO and RA of the lane change, HSSO
     ``low_speed``        the low-speed 90-degree turn: swept width, offtracking, tail and frontal swing
+    ``rollover``         the static rollover threshold: quasi-static, lift-off axle by axle, exact events
+    ``roll``             the roll measures: LTR, roll gains, the yaw-roll model's RA, HSTO, damping
     ``measure_set``      every measure of a vehicle at a speed (MeasureSet)
     ``criteria``         the user's limits and the verdicts
 ``tracking/``            **straight-line tracking** over a tire population:
@@ -112,6 +118,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``measures``         measures (text, CSV, JSON from the registry)
     ``tracking``         tracking place, tracking stats
     ``turn``             the low-speed turn
+    ``roll``             the static rollover threshold, roll gains, LTR
     ``artifacts``        fmu, report, study
 ``_entry``               the console script (one BLAS thread first)
 

@@ -313,7 +313,9 @@ def test_a_misalignment_of_the_only_steered_axle_is_a_steer_and_crossfall_is_the
     np.testing.assert_array_equal(co.B_eps[:, steered[0]], co.B_delta())
     one = load_vehicle(EXAMPLES / "b_double.toml")
     from lcvreport.model.vehicle import Vehicle
-    truck = Vehicle("truck", (one.units[0].__class__(**{**one.units[0].__dict__, "rear_coupling_m": None}),))
+    truck = Vehicle("truck", (one.units[0].__class__(**{**one.units[0].__dict__, "rear_coupling_m": None,
+                                                        "rear_coupling_height_m": None,
+                                                        "rear_coupling_roll_stiffness_Nm_per_rad": None}),))
     cot = system_coefficients(truck)
     assert cot.B_crossfall[0] == pytest.approx(truck.units[0].mass_kg * 9.80665, rel=1e-15)
     assert cot.B_crossfall[1] == 0.0

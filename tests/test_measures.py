@@ -234,7 +234,11 @@ SPEC_KEYS = {"speed_mps", "least_damping_ratio", "least_damped_frequency_hz", "c
              "hsto_m", "ra_lane_change", "hsso_m", "steady_turn_delta_rad",
              "lssp_m", "low_speed_offtracking_m", "max_tail_swing_m", "frontal_swing_m",
              "yaw_damping_lower_bound",     # SPEC 12 (corrected 2026-12): YDC of a heavily damped vehicle
-             "reasons"}                     # issue 29: why each null is null
+             "reasons",                     # issue 29: why each null is null
+             # SPEC 17: the roll measures (null, with the missing key named, without roll data)
+             "srt_g", "srt_rrcu_g", "srt_min_g", "roll_least_damping_ratio", "roll_critical_speed_kph",
+             "ra_single_sine_roll", "ltr_single_sine", "ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change",
+             "rltr_lane_change", "roll_gain_deg_per_g"}
 
 
 @pytest.mark.parametrize("source", [["--preset", "aucnat"]] + [["--vehicle", str(EXAMPLES / f"{n}.toml")]

@@ -380,7 +380,9 @@ def test_every_scalar_the_json_prints_can_be_judged(tmp_path):
                               "--criteria", str(crit), "--json"], capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
     doc = json.loads(p.stdout)
-    printed = {k for k, v in doc.items() if isinstance(v, (int, float)) or v is None} - {"speed_mps"}
+    from lcvreport.measures.registry import MEASURES
+    printed = {k for k, v in doc.items() if (isinstance(v, (int, float)) or v is None)
+               and MEASURES[k].shape == "scalar"} - {"speed_mps"}
     printed |= {f"trim.{k}" for k in doc["trim"]}
     assert printed <= set(doc["verdicts"]) == set(CRITERIA_KEYS)
     assert doc["verdicts"]["lssp_m"]["verdict"] == "pass" and doc["verdicts"]["trim.offtracking_m"]["verdict"] == "pass"

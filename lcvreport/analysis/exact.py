@@ -99,27 +99,29 @@ class ManoeuvreResponse:
             raise KeyError(f"no signal {name!r}; signals: {', '.join(self.signal_names)}, y2..") from None
 
     def _rear_offsets(self) -> np.ndarray:
-        Theta = np.concatenate([seg.Z @ (seg.C[self._theta_rows].T) for seg in self.segments]) if \
-            self._theta_rows else np.zeros((self.time.size, 0))
-        return np.sin(Theta) @ rear_end_weights(self.vehicle).T
+        Theta = self._hidden("Theta")
+        y = np.sin(Theta) @ rear_end_weights(self.vehicle).T
+        roll = self._hidden("Roff")                  # the yaw-roll model's coupling roll offsets
+        return y + roll if roll.shape[1] else y
 
-    @property
-    def _theta_rows(self) -> list:
-        return [self.signal_names.index(n) for n in self.signal_names if n.startswith("Theta")]
+    def _hidden(self, prefix: str) -> np.ndarray:
+        rows = [j for j, n in enumerate(self.signal_names) if n.startswith(prefix)]
+        if not rows:
+            return np.zeros((self.time.size, 0))
+        return np.concatenate([seg.Z @ (seg.C[rows].T) for seg in self.segments])
 
     def columns(self) -> list[str]:
         """Output columns with units, in the order of :meth:`matrix`."""
         out = ["time_s"]
         for n in self.signal_names:
-            if n.startswith("Theta"):
-                continue
-            out.append(f"{n}_{_UNIT[_kind(n)]}")
+            if not _is_hidden(n):
+                out.append(_column(n))
         out += [f"y{k}_m" for k in range(2, self.vehicle.n_units + 1)]
         return out
 
     def matrix(self) -> np.ndarray:
         """Every signal at every sample, columns as :meth:`columns`."""
-        keep = [j for j, n in enumerate(self.signal_names) if not n.startswith("Theta")]
+        keep = [j for j, n in enumerate(self.signal_names) if not _is_hidden(n)]
         with np.errstate(over="ignore", invalid="ignore"):     # an overflowed (unstable) run: callers refuse it
             lin = np.concatenate([seg.Z @ seg.C[keep].T for seg in self.segments])
             return np.column_stack([self.time, lin, self._rear_offsets()])
@@ -228,15 +230,21 @@ class ManoeuvreResponse:
         return plot_manoeuvre(self, signals, ax)
 
 
-_UNIT = {"delta": "rad", "v": "m_per_s", "r": "rad_per_s", "theta": "rad", "psi": "rad", "Y": "m",
-         "ay": "m_per_s2", "a": "m_per_s2"}
+#: the unit of every signal, by the start of its name (first match); ``ltr<g>`` is dimensionless
+_UNITS = (("delta", "rad"), ("theta", "rad"), ("psi", "rad"), ("phi", "rad"), ("ay", "m_per_s2"),
+          ("as", "m_per_s2"), ("a_steer", "m_per_s2"), ("dFz_", "N"), ("ltr", ""), ("Y", "m"), ("v", "m_per_s"),
+          ("r", "rad_per_s"), ("p", "rad_per_s"))
 
 
-def _kind(name: str) -> str:
-    for k in ("delta", "theta", "psi", "ay", "a_steer", "Y", "v", "r"):
-        if name.startswith(k):
-            return "a" if k == "a_steer" else k
-    return "Y"
+def _column(name: str) -> str:
+    """The column header of a signal: its name and unit (``phi2_rad``, ``dFz_a1_N``, ``ltr1``)."""
+    unit = next((u for prefix, u in _UNITS if name.startswith(prefix)), "m")
+    return f"{name}_{unit}" if unit else name
+
+
+def _is_hidden(name: str) -> bool:
+    """Rows kept for the rear offsets, not output columns."""
+    return name.startswith("Theta") or name.startswith("Roff")
 
 
 def steered_point(vehicle: Vehicle) -> float:
@@ -261,7 +269,8 @@ def _steer_axle_maps(vehicle, speed_mps, tire_scale, model: str = "yaw_plane"):
 
 def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float, dt: float,
              F: np.ndarray | None = None, tire_scale: float = 1.0, t_start: float = 0.0,
-             state: np.ndarray | None = None, model: str = "yaw_plane") -> ManoeuvreResponse:
+             state: np.ndarray | None = None, model: str = "yaw_plane",
+             axle_force_N: np.ndarray | None = None) -> ManoeuvreResponse:
     """The exact response from rest to ``steer`` (continuous) and the constant
     generalized force ``F`` (residual sources, SI), sampled every ``dt`` to ``t_end``.
 
@@ -284,7 +293,12 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
         chunks); the samples are then ``t_start + k dt``.
     model : str
         The linear model (:data:`lcvreport.model.linear.MODELS`; default the yaw plane):
-        its states, and the positions and accelerations it defines.
+        its states, and the positions, accelerations and further outputs it defines
+        (:meth:`~lcvreport.model.linear.LinearModel.extra_signals`: the yaw-roll model's
+        ``as<i>``, ``dFz_<axle>``, ``ltr<g>``).
+    axle_force_N : numpy.ndarray, optional
+        Each axle's constant lateral tire force of the residual sources [N] (P plus the
+        misalignment's ``s C_F eps``): the load transfer outputs include it.
 
     Raises
     ------
@@ -335,8 +349,13 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
         for a in unit.axles:
             Y_rows.append(co.point_lateral_row(i, a.x_m))
             Y_names.append(f"Y_{a.name}")
-    signal_names = tuple(["delta"] + names + names_ay + ["a_steer"] + Y_names +
-                         [f"Theta{k + 2}" for k in range(nu - 1)])
+    ex_names, EX, EXD, ED, EO = co.extra_signals(u, tire_scale)
+    ex_const = EO @ (np.zeros(len(vehicle.axles)) if axle_force_N is None else np.asarray(axle_force_N, float))
+    roll_rows = co.roll_offset_rows()
+    hidden_roll = [] if roll_rows is None else [f"Roff{k + 2}" for k in range(nu - 1)]
+    ne = len(ex_names)
+    signal_names = tuple(["delta"] + names + names_ay + ["a_steer"] + Y_names + list(ex_names) +
+                         [f"Theta{k + 2}" for k in range(nu - 1)] + hidden_roll)
     segments = []
     t_grid = t_start + np.arange(n_steps + 1) * dt
     z_state = np.zeros(m) if state is None else np.asarray(state, dtype=float)   # [x, psi1, Y1]
@@ -373,7 +392,7 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
             d_row = np.zeros(dim)
             d_row[m:m + p] = piece.h
         # rows: the steer, the states and psi1, Y1, ay of every unit, a_steer, Y of every axle, Theta
-        C = np.zeros((1 + m + nu + 1 + len(Y_rows) + nu - 1, dim))
+        C = np.zeros((1 + m + nu + 1 + len(Y_rows) + ne + (nu - 1) * (1 + bool(hidden_roll)), dim))
         C[0] = d_row
         C[1:1 + m, :m] = np.eye(m)
         r0 = 1 + m
@@ -389,7 +408,16 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
         if Y_rows:
             C[r0:r0 + len(Y_rows), :m] = Y_rows
         r0 += len(Y_rows)
+        if ne:
+            # y = X x + XD x' + D delta + O F_y0, x' from the augmented dynamics' first n rows
+            C[r0:r0 + ne, :n] = EX
+            C[r0:r0 + ne] += EXD @ Mz[:n]
+            C[r0:r0 + ne] += np.outer(ED, d_row)
+            C[r0:r0 + ne, -1] += ex_const
+        r0 += ne
         C[r0:r0 + nu - 1, :m] = cum
+        if hidden_roll:
+            C[r0 + nu - 1:r0 + 2 * (nu - 1), :n] = roll_rows
         z0 = np.r_[z_state, piece.xi0, 1.0]
         t1 = min(piece.t1, math.inf)
         ka = int(math.ceil((piece.t0 - t_start) / dt - 1e-9))
@@ -436,5 +464,5 @@ def check_lane_change_steer(r: ManoeuvreResponse, peak_rad: float | None = None)
 def final_state(r: ManoeuvreResponse) -> np.ndarray:
     """[x, psi1, Y1] at the last sample of ``r`` (to continue a run in chunks)."""
     seg = r.segments[-1]
-    m = linear_model(r.vehicle).n_states + 2
+    m = r.signal_names.index("Y1")               # delta, the n states, psi1, Y1: z = [x, psi1, Y1] is n + 2 long
     return seg.Z[-1, :m].copy()

@@ -39,6 +39,7 @@ from .measures import _cmd_measures
 from .model import _cmd_eig, _cmd_matrices, _cmd_presets, _cmd_steady
 from .options import UsageError, _help_range, _line, _ranged
 from .output import OutputError, _Out
+from .roll import _cmd_roll
 from .simulate import _cmd_simulate
 from .tracking import _cmd_tracking
 from .turn import _cmd_turn
@@ -62,7 +63,7 @@ def build_parser() -> argparse.ArgumentParser:
     from ..model.presets import MASS_OPTIONS, PRESETS
     from importlib.metadata import version
     __version__ = version("lcvreport")
-    p = _Parser(prog="lcv", description="Linear yaw-plane model of long combination vehicles.")
+    p = _Parser(prog="lcv", description="Linear yaw-plane and yaw-roll models of long combination vehicles.")
     p.add_argument("--version", action="version", version=f"lcv (lcvreport) {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
@@ -131,6 +132,9 @@ def build_parser() -> argparse.ArgumentParser:
                           "with g, e.g. 0.15g); default none")
     sim.add_argument("--t-end", default=10.0, type=_ranged("t_end", what="end time in s"), metavar="T",
                      help=f"end time [s], in {_help_range('t_end')}; default 10")
+    sim.add_argument("--model", default="yaw-plane", choices=("yaw-plane", "yaw-roll"),
+                     help="the linear model: yaw-plane (default) or yaw-roll (adds roll rates, roll angles, sprung "
+                          "CG accelerations, axle load transfers and load transfer ratios; needs the roll keys)")
     sim.add_argument("--dt", default=0.01, type=_ranged("output_step", what="output step in s"), metavar="H",
                      help=f"output step [s], in {_help_range('output_step')}; must divide t-end; default 0.01")
     mea = sub.add_parser("measures", help="yaw-plane measures: damping, RA, YDC, HSTO, HSSO, trim, the low-speed "
@@ -232,13 +236,18 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--criteria", metavar="FILE", help="with --report: limits to judge the cases by (TOML)")
     st.add_argument("--no-pdf", action="store_true", help="with --report: HTML only")
     st.add_argument("--json", action="store_true", help="machine-readable summary")
+    rol = sub.add_parser("roll", help="roll: static rollover threshold per roll-coupled group (lift-off axle by "
+                                      "axle), roll gains, load transfer ratios, roll modes (docs/roll.md)")
+    common(rol, None)
+    rol.add_argument("--plot", metavar="FILE", help="write the a_y - phi curve of every group, each lift-off marked "
+                                                    "(.png, .pdf or .svg; a new file)")
     sub.add_parser("presets", help="list the presets").add_argument("--json", action="store_true")
     return p
 
 
 COMMANDS = {"presets": _cmd_presets, "eig": _cmd_eig, "matrices": _cmd_matrices, "steady": _cmd_steady,
             "simulate": _cmd_simulate, "measures": _cmd_measures, "fmu": _cmd_fmu, "report": _cmd_report,
-            "tracking": _cmd_tracking, "turn": _cmd_turn, "study": _cmd_study}
+            "tracking": _cmd_tracking, "turn": _cmd_turn, "study": _cmd_study, "roll": _cmd_roll}
 
 
 def run(argv: Sequence[str] | None = None, out=None) -> int:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 
 
+from ..measures.registry import MEASURES
 from ..units import mps_to_kph
 from .options import UsageError, _load_units, _parse_speeds, _sources, _vehicle
 from .output import _finite, _Out
@@ -71,6 +72,12 @@ def _flatten(doc: dict, vehicle) -> dict:
         if key == "ay_gain_per_unit":
             for name, g in zip(vehicle.unit_names, val or [None] * vehicle.n_units):
                 flat[f"ay_gain_{name}_m_per_s2_per_rad"] = g
+        elif key == "roll_gain_deg_per_g":
+            for name, g in zip(vehicle.unit_names, val or [None] * vehicle.n_units):
+                flat[f"roll_gain_{name}_deg_per_g"] = g
+        elif key in PER_GROUP:                   # one column per roll-coupled group, front to rear
+            for g, x in enumerate(val or [None] * _groups(vehicle)):
+                flat[f"{key}.group{g + 1}"] = x
         elif key == "trim":                      # the registry's keys (trim.delta_rad, trim.offtracking_m)
             flat["trim.delta_rad"] = None if val is None else val["delta_rad"]
             flat["trim.offtracking_m"] = None if val is None else val["offtracking_m"]
@@ -82,6 +89,15 @@ def _flatten(doc: dict, vehicle) -> dict:
         else:
             flat[key] = val
     return flat
+
+
+#: the measures with one value per roll-coupled group
+PER_GROUP = tuple(k for k, m in MEASURES.items() if m.shape == "per_group")
+
+
+def _groups(vehicle) -> int:
+    """The vehicle's number of roll-coupled groups (by its couplings' roll stiffness; 1 without data)."""
+    return 1 + sum(1 for u in vehicle.units[:-1] if u.rear_coupling_roll_stiffness_Nm_per_rad == 0.0)
 
 
 def _flat_columns(doc: dict, vehicle) -> list[str]:

@@ -65,6 +65,22 @@ def _vehicle(args: argparse.Namespace):
     return v
 
 
+def _plot_path(args: argparse.Namespace):
+    """The new figure file of ``--plot`` (None without it): .png, .pdf or .svg, not an existing
+    file, in an existing folder."""
+    from pathlib import Path
+    if args.plot is None:
+        return None
+    plot = Path(args.plot)
+    if plot.suffix.lower() not in (".png", ".pdf", ".svg"):
+        raise UsageError(f"argument --plot: {plot} must end in .png, .pdf or .svg")
+    if plot.exists() or plot.is_symlink():
+        raise UsageError(f"argument --plot: {plot} exists; name a new file (lcv never overwrites one)")
+    if not plot.parent.is_dir():
+        raise UsageError(f"argument --plot: the folder {plot.parent} does not exist")
+    return plot
+
+
 def _speed_mps(args: argparse.Namespace) -> float:
     if getattr(args, "speed_kph", None) is not None:
         return args.speed_kph * MPS_PER_KPH
@@ -89,14 +105,19 @@ def _load_units(args: argparse.Namespace, vehicle) -> list[str]:
         raise UsageError(f"argument --load: {exc.args[0]}") from None
 
 
-def _load_vector(args: argparse.Namespace, vehicle, units=SI) -> np.ndarray:
+def _load_vector(args: argparse.Namespace, vehicle, units=SI, model: str = "yaw_plane") -> np.ndarray:
+    return _one_percent_vector(args, vehicle, units, model)[0]
+
+
+def _one_percent_vector(args: argparse.Namespace, vehicle, units=SI, model: str = "yaw_plane"):
+    """(F, P per axle [N]) of the 1 % rule on ``--load``."""
     from ..model.yaw_plane.loads import load_vector, one_percent_rule
     names = _load_units(args, vehicle)
     try:
         res = one_percent_rule(vehicle, names, t_sign=1.0)
     except ValueError as exc:
         raise UsageError(f"argument --load: {exc}") from None
-    return load_vector(vehicle, res, args.convention, units)
+    return load_vector(vehicle, res, args.convention, units, model), res.vectors(vehicle)[0]
 
 
 def _source_force(args: argparse.Namespace, vehicle):

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
-from ..model.linear import linear_model
+from ..model.linear import check_model, linear_model
 from ..ranges import RANGES, RangeError
-from .options import UsageError, _load_vector, _sources, _speed_mps, _vehicle
+from .options import UsageError, _one_percent_vector, _sources, _speed_mps, _vehicle
 from .output import _finite, _Out
 
 
@@ -33,9 +33,19 @@ def _cmd_simulate(args, out: _Out) -> int:
         raise UsageError(f"argument --steer: {exc}") from None
     if args.steer is not None and not v.steered_axles:
         raise UsageError(f"argument --steer: {v.name} has no steered axle")
-    F = _load_vector(args, v) if args.load is not None else np.zeros(linear_model(v).n_states)
+    model = check_model(args.model)
+    if model == "yaw_roll":
+        from .roll import roll_vehicle
+        roll_vehicle(args)                      # the roll keys, checked: one line naming what is missing
+    axle_force = np.zeros(len(v.axles))
+    if args.load is not None:
+        F, axle_force = _one_percent_vector(args, v, model=model)
+    else:
+        F = np.zeros(linear_model(v, model).n_states)
     try:
-        F = F + _sources(args, v).vector(v, args.tire_scale)
+        src = _sources(args, v)
+        F = F + src.vector(v, args.tire_scale, model)
+        axle_force = axle_force + src.axle_forces(v, args.tire_scale)
     except (KeyError, RangeError) as exc:
         raise UsageError(f"argument: {exc.args[0]}") from None
     u = _speed_mps(args)
@@ -46,7 +56,8 @@ def _cmd_simulate(args, out: _Out) -> int:
         n = min(chunk, steps - k)
         t_b = (k + n) * args.dt
         try:
-            r = response(v, u, steer, t_b, args.dt, F, args.tire_scale, t_start=k * args.dt, state=state)
+            r = response(v, u, steer, t_b, args.dt, F, args.tire_scale, t_start=k * args.dt, state=state,
+                         model=model, axle_force_N=axle_force)
             check_lane_change_steer(r)      # a computed steer beyond [-1, 1] rad: refused before a row is written
         except ManoeuvreError as exc:
             raise UsageError(f"argument --steer: {exc}") from None

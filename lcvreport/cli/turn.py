@@ -1,10 +1,7 @@
 """``lcv turn``: the low-speed turn and its measures, with the swept-path figure."""
 from __future__ import annotations
 
-from pathlib import Path
-
-
-from .options import UsageError, _line, _vehicle
+from .options import UsageError, _line, _plot_path, _vehicle
 from .output import _Out, _write_figure_new
 
 
@@ -12,15 +9,7 @@ def _cmd_turn(args, out: _Out) -> int:
     from ..measures.low_speed import low_speed_turn
     from ..model.body import TurnError
     v = _vehicle(args)
-    plot = None
-    if args.plot is not None:
-        plot = Path(args.plot)
-        if plot.suffix.lower() not in (".png", ".pdf", ".svg"):
-            raise UsageError(f"argument --plot: {plot} must end in .png, .pdf or .svg")
-        if plot.exists() or plot.is_symlink():
-            raise UsageError(f"argument --plot: {plot} exists; name a new file (lcv never overwrites one)")
-        if not plot.parent.is_dir():
-            raise UsageError(f"argument --plot: the folder {plot.parent} does not exist")
+    plot = _plot_path(args)
     try:
         t = low_speed_turn(v, args.radius, args.angle_deg)
     except TurnError as exc:

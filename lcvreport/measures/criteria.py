@@ -6,6 +6,14 @@ No limits are built in: a criteria file names the standard and its numbers::
     ra_single_sine = { max = 2.0, source = "the standard, clause and edition" }
     yaw_damping_coefficient = { min = 0.15, source = "..." }
 
+A limit may be relative to another measure of the same vehicle, as a factor times its key::
+
+    ra_single_sine_roll = { max = "5.7 * srt_rrcu_g", source = "..." }
+
+(the rearward amplification of the Australian scheme is limited relative to the static
+rollover threshold of the rearmost roll-coupled unit); where that measure is null the limit
+is not computed, and the verdict says which measure it needed.
+
 Keys are the measure registry's (:data:`lcvreport.measures.registry.CRITERIA_KEYS`: the scalar
 keys of ``lcv measures --json``, ``trim.offtracking_m`` for the trim, with an absolute value
 when ``abs = true``).  A verdict is ``pass``, ``fail`` or ``not computed`` (the measure is
@@ -23,6 +31,7 @@ Examples
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,12 +49,28 @@ class CriteriaError(ValueError):
 
 
 @dataclass(frozen=True)
+class Relative:
+    """A bound that is ``factor`` times another measure ``key`` of the same vehicle."""
+
+    factor: float
+    key: str
+
+    def __format__(self, spec: str) -> str:
+        return self.key if self.factor == 1.0 else f"{self.factor:g} * {self.key}"
+
+
+#: a relative bound as a criteria file writes it: "5.7 * srt_rrcu_g" or "srt_rrcu_g"
+_RELATIVE = re.compile(r"\s*(?:([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*\*\s*)?([A-Za-z_][A-Za-z0-9_.]*)\s*\Z")
+
+
+@dataclass(frozen=True)
 class Limit:
-    """One limit: ``min <= value <= max`` (either may be None), its source, on |value| if ``absolute``."""
+    """One limit: ``min <= value <= max`` (either may be None, or a :class:`Relative` bound), its
+    source, on |value| if ``absolute``."""
 
     key: str
-    min: float | None
-    max: float | None
+    min: float | Relative | None
+    max: float | Relative | None
     source: str
     absolute: bool = False
 
@@ -54,6 +79,21 @@ class Limit:
         if self.min is not None and self.max is not None:
             return f"{self.min:g} <= {v} <= {self.max:g}"
         return f"{v} >= {self.min:g}" if self.min is not None else f"{v} <= {self.max:g}"
+
+    @property
+    def references(self) -> tuple[str, ...]:
+        """The measures its bounds are relative to."""
+        return tuple(b.key for b in (self.min, self.max) if isinstance(b, Relative))
+
+    def resolved(self, lookup) -> "Limit":
+        """The limit with every relative bound replaced by ``factor * lookup(key)`` (a number, an
+        array, or NaN where the measure is null)."""
+        def value(b):
+            if not isinstance(b, Relative):
+                return b
+            x = lookup(b.key)
+            return b.factor * (math.nan if x is None else np.asarray(x, dtype=float))
+        return Limit(self.key, value(self.min), value(self.max), self.source, self.absolute)
 
 
 @dataclass(frozen=True)
@@ -88,20 +128,41 @@ def load_criteria(path: str | Path) -> Criteria:
         if not isinstance(spec, dict) or set(spec) - {"min", "max", "source", "abs"}:
             raise CriteriaError(f"limits.{key}: expected {{ min = .., max = .., source = \"..\", abs = false }}")
         lo, hi = spec.get("min"), spec.get("max")
+        bounds = []
         for name, val in (("min", lo), ("max", hi)):
+            if isinstance(val, str):
+                bounds.append(_relative(key, name, val))
+                continue
             if val is not None and (isinstance(val, bool) or not isinstance(val, (int, float)) or
                                     not math.isfinite(val)):
-                raise CriteriaError(f"limits.{key}.{name} must be a finite number, got {val!r}")
+                raise CriteriaError(f"limits.{key}.{name} must be a finite number or \"<factor> * <measure key>\", "
+                                    f"got {val!r}")
+            bounds.append(None if val is None else float(val))
+        lo, hi = bounds
         if lo is None and hi is None:
             raise CriteriaError(f"limits.{key}: give min, max or both")
-        if lo is not None and hi is not None and lo > hi:
-            raise CriteriaError(f"limits.{key}: min {lo} is above max {hi}")
+        if isinstance(lo, float) and isinstance(hi, float) and lo > hi:
+            raise CriteriaError(f"limits.{key}: min {lo:g} is above max {hi:g}")
         source = spec.get("source")
         if not isinstance(source, str) or not source.strip():
             raise CriteriaError(f"limits.{key}.source: name the standard the limit comes from")
-        limits[key] = Limit(key, None if lo is None else float(lo), None if hi is None else float(hi), source,
-                            bool(spec.get("abs", False)))
+        limits[key] = Limit(key, lo, hi, source, bool(spec.get("abs", False)))
     return Criteria(limits)
+
+
+def _relative(key: str, name: str, text: str) -> Relative:
+    m = _RELATIVE.match(text)
+    if m is None:
+        raise CriteriaError(f"limits.{key}.{name} must be a number or \"<factor> * <measure key>\" (e.g. "
+                            f"\"5.7 * srt_rrcu_g\"), got {text!r}")
+    factor = 1.0 if m.group(1) is None else float(m.group(1))
+    if not math.isfinite(factor):
+        raise CriteriaError(f"limits.{key}.{name}: the factor must be finite, got {m.group(1)!r}")
+    if m.group(2) not in KEYS:
+        raise CriteriaError(f"limits.{key}.{name}: {unknown_key_message(m.group(2))}")
+    if m.group(2) == key:
+        raise CriteriaError(f"limits.{key}.{name}: a limit cannot be relative to its own measure")
+    return Relative(factor, m.group(2))
 
 
 def _value(doc: dict, key: str):
@@ -137,14 +198,18 @@ def judge_values(lim: Limit, values, lower_bounds=None):
     x = np.asarray(values, dtype=float)
     if lim.absolute:
         x = np.abs(x)
-    has = np.isfinite(x)
+    if lim.references:
+        raise ValueError(f"limit on {lim.key}: resolve its relative bounds first (Limit.resolved)")
+    bounds_known = np.isfinite(np.broadcast_to(np.asarray(lim.min if lim.min is not None else 0.0, float), x.shape)) & \
+        np.isfinite(np.broadcast_to(np.asarray(lim.max if lim.max is not None else 0.0, float), x.shape))
+    has = np.isfinite(x) & bounds_known
     xv = np.where(has, x, 0.0)
     ok = has & ((lim.min is None) | (xv >= (lim.min if lim.min is not None else 0.0))) & \
         ((lim.max is None) | (xv <= (lim.max if lim.max is not None else 0.0)))
     judged = has.copy()
     if lower_bounds is not None and not lim.absolute:
         L = np.broadcast_to(np.asarray(lower_bounds, dtype=float), x.shape)
-        bounded = ~has & np.isfinite(L)
+        bounded = ~np.isfinite(x) & bounds_known & np.isfinite(L)
         Lv = np.where(bounded, L, 0.0)
         if lim.max is not None:
             fails = bounded & (Lv > lim.max)
@@ -162,20 +227,26 @@ def judge(criteria: Criteria, doc: dict) -> dict:
     unless it stands for a lower bound (:func:`null_lower_bound`) that decides the limit
     (:func:`judge_values`)."""
     out = {}
-    for key, lim in criteria.limits.items():
+    for key, spec in criteria.limits.items():
         value = _value(doc, key)
         bound = null_lower_bound(doc, key)
+        lim = spec.resolved(lambda k: _value(doc, k))
         judged, ok = judge_values(lim, [math.nan if value is None else value],
                                   [math.nan if bound is None else bound])
+        missing = [k for k in spec.references if _value(doc, k) is None]
         if judged[0]:
             verdict = "pass" if ok[0] else "fail"
-            note = f"{lim.text()} ({lim.source})" + ("" if value is not None else
-                                                     f"; the measure is at least {bound:g}")
+            note = f"{spec.text()} = {lim.text()} ({lim.source})" if spec.references else f"{lim.text()} ({lim.source})"
+            note += "" if value is not None else f"; the measure is at least {bound:g}"
+        elif missing:
+            why = (doc.get("reasons") or {}).get(missing[0])
+            verdict, note = "not computed", f"the limit is relative to {missing[0]}, which is null here" + (
+                f": {why}" if why else "")
         else:
             why = (doc.get("reasons") or {}).get(key.split(".")[0] if key.startswith("trim.") else key)
             verdict, note = "not computed", f"the measure is null here: {why}" if why else \
                 "the measure is null here (see the measures' notes)"
-        out[key] = {"verdict": verdict, "value": value, "limit": lim.text(), "source": lim.source, "note": note}
+        out[key] = {"verdict": verdict, "value": value, "limit": spec.text(), "source": lim.source, "note": note}
     return out
 
 

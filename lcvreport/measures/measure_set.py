@@ -12,8 +12,8 @@ Examples
 >>> from lcvreport import load_preset
 >>> from lcvreport.units import kph_to_mps
 >>> m = measure_set(load_preset("aucnat"), kph_to_mps(88.0), load_units=["trailer2", "trailer3"])
->>> sorted(m.to_dict())[:6]
-['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m', 'hsto_m', 'least_damped_frequency_hz']
+>>> sorted(m.to_dict())[:5]
+['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m', 'hsto_m']
 """
 from __future__ import annotations
 
@@ -102,13 +102,16 @@ class MeasureSet:
             if key == "speed_mps":
                 rows.append({"measure": m.label, "value": value, "unit": m.unit,
                              "note": f"{mps_to_kph(self.speed_mps):.1f} km/h", "json_key": key})
-            elif m.shape == "per_unit":
+            elif m.shape in ("per_unit", "per_group"):
                 if value is None:
                     rows.append({"measure": m.label + "s", "value": "none", "unit": m.unit,
                                  "note": self.reason(key), "json_key": key})
-                for k, (name, g) in enumerate(zip(self.vehicle.unit_names, value or ())):
+                names = self.vehicle.unit_names if m.shape == "per_unit" else [
+                    f"group {g + 1}" for g in range(len(value or ()))]
+                for k, (name, g) in enumerate(zip(names, value or ())):
+                    note = f"|G_{k + 1}(j2π·{f})|" if key == "ay_gain_per_unit" else m.definition
                     rows.append({"measure": f"{m.label}, {name}", "value": g, "unit": m.unit,
-                                 "note": f"|G_{k + 1}(j2π·{f})|", "json_key": f"{key}[{k}]"})
+                                 "note": note, "json_key": f"{key}[{k}]"})
             elif key.startswith("trim."):
                 if self.trim is not None:
                     what = "; ".join(x for x in (f"1 % rule on {', '.join(self.load_units)}" if self.load_units

@@ -41,7 +41,8 @@ from ..util.numerics import solve_scaled
 
 #: the linear models: name -> "module:builder" (relative to this package); the builder takes
 #: (vehicle, units) and returns a LinearModel
-MODELS = {"yaw_plane": "yaw_plane.equations:system_coefficients"}
+MODELS = {"yaw_plane": "yaw_plane.equations:system_coefficients",
+          "yaw_roll": "yaw_roll.equations:yaw_roll_coefficients"}
 #: the spelling of the command line (``--model yaw-plane``) for each model
 CLI_NAMES = {name: name.replace("_", "-") for name in MODELS}
 #: (A, G) pairs kept per model by :meth:`LinearModel.state_derivative_maps`
@@ -142,6 +143,26 @@ class LinearModel:
         """The lateral position of the point ``x_m`` [m] of unit ``unit`` (0-based) over
         ``[psi1, Y1, x]`` (a map of length n + 2)."""
         raise NotImplementedError
+
+    def articulation_rows(self) -> np.ndarray:
+        """Rows picking the articulation angles ``theta_k`` out of the state, shape (N-1, n)."""
+        nu = self.vehicle.n_units
+        idx = [self.state_names.index(name) for name in self.state_names if name.startswith("theta")]
+        rows = np.zeros((nu - 1, self.n_states))
+        rows[np.arange(nu - 1), idx] = 1.0
+        return rows
+
+    def roll_offset_rows(self) -> np.ndarray | None:
+        """Rows over the state of the lateral offsets [m] a model adds to units 2..N beyond the
+        yaw-plane chain geometry (the yaw-roll model's roll of the couplings), or None."""
+        return None
+
+    def extra_signals(self, speed_mps: float, tire_scale: float = 1.0) -> tuple:
+        """Outputs beyond the states and the ``ay``: ``(names, X, XD, D, O)`` with
+        ``y = X x + XD x' + D delta + O F_y0`` (``F_y0`` each axle's constant tire force, N).
+        None for the yaw plane; the yaw-roll model's roll outputs."""
+        n, na = self.n_states, len(self.vehicle.axles)
+        return [], np.zeros((0, n)), np.zeros((0, n)), np.zeros(0), np.zeros((0, na))
 
     def state_derivative_maps(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(A, G) with ``x' = A x + G F``: ``A = M^-1 S``, ``G = M^-1`` (equilibrated solve).

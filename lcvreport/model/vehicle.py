@@ -47,6 +47,11 @@ from numbers import Integral, Real
 from ..ranges import GYRATION_PER_REACH_MIN, VEHICLE, RangeError
 from .yaw_plane.states import joint_letter
 
+#: the roll keys of a unit and of an axle (docs/roll.md), each its own range in VEHICLE
+UNIT_ROLL_KEYS = ("cg_height_m", "roll_axis_height_m", "roll_inertia_kg_m2", "yaw_roll_product_kg_m2",
+                  "rear_coupling_height_m", "rear_coupling_roll_stiffness_Nm_per_rad")
+AXLE_ROLL_KEYS = ("roll_stiffness_Nm_per_rad", "roll_damping_Nms_per_rad", "unsprung_mass_kg")
+
 #: names the vehicle itself may have (it is also the FMU's model name)
 VEHICLE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
@@ -127,7 +132,12 @@ class Axle:
         Static vertical load [N]; needed only by the 1 % rule.
     track_width_m : float or None
         Lateral distance between the centres of the outermost tires [m]; needed only by
-        the low-speed turn (docs/low_speed_turn.md).
+        the low-speed turn (docs/low_speed_turn.md) and roll (docs/roll.md).
+    roll_stiffness_Nm_per_rad, roll_damping_Nms_per_rad : float or None
+        The suspension's roll stiffness K [N*m/rad] and damping C [N*m*s/rad], >= 0, sprung
+        mass relative to the axle; roll only (docs/roll.md).
+    unsprung_mass_kg : float or None
+        The axle's unsprung mass [kg], >= 0, part of its unit's ``mass_kg``; roll only.
     """
 
     name: str
@@ -140,6 +150,9 @@ class Axle:
     steered: bool = False
     static_load_N: float | None = None
     track_width_m: float | None = None
+    roll_stiffness_Nm_per_rad: float | None = None
+    roll_damping_Nms_per_rad: float | None = None
+    unsprung_mass_kg: float | None = None
 
     def __post_init__(self):
         _name("name", self.name, AXLE_NAME, "a name of letters, digits and _")
@@ -155,8 +168,9 @@ class Axle:
             raise VehicleError("steered", f"steered must be true or false, got {self.steered!r}")
         if self.static_load_N is not None:
             set_("static_load_N", _number("static_load_N", self.static_load_N, "static_load_N"))
-        if self.track_width_m is not None:
-            set_("track_width_m", _number("track_width_m", self.track_width_m, "track_width_m"))
+        for key in ("track_width_m",) + AXLE_ROLL_KEYS:
+            if getattr(self, key) is not None:
+                set_(key, _number(key, getattr(self, key), key))
 
     # per-axle sums (tires x per-tire coefficient)
     @property
@@ -201,6 +215,18 @@ class Unit:
         needed only by the low-speed turn and the drawings (docs/low_speed_turn.md).
     body_width_m : float or None
         Width of the body [m], symmetric about the unit's axis.
+    cg_height_m, roll_axis_height_m : float or None
+        Heights above ground [m] of the sprung mass's CG (h, in (0, 5]) and of the unit's
+        roll axis (h_r, in [0, h)); roll only (docs/roll.md).
+    roll_inertia_kg_m2 : float or None
+        I_x of the sprung mass about a longitudinal axis through its CG [kg*m^2], > 0.
+    yaw_roll_product_kg_m2 : float or None
+        I_xz of the sprung mass about its CG, x forward and z down [kg*m^2] (None: 0).
+    rear_coupling_height_m : float or None
+        Height of the rear coupling above ground [m] (units with a rear coupling).
+    rear_coupling_roll_stiffness_Nm_per_rad : float or None
+        Roll stiffness of the rear coupling [N*m/rad]: 0 roll-free (a drawbar eye), > 0
+        roll-coupled (a fifth wheel).
     """
 
     name: str
@@ -213,6 +239,12 @@ class Unit:
     body_front_m: float | None = None
     body_rear_m: float | None = None
     body_width_m: float | None = None
+    cg_height_m: float | None = None
+    roll_axis_height_m: float | None = None
+    roll_inertia_kg_m2: float | None = None
+    yaw_roll_product_kg_m2: float | None = None
+    rear_coupling_height_m: float | None = None
+    rear_coupling_roll_stiffness_Nm_per_rad: float | None = None
 
     def __post_init__(self):
         _name("name", self.name, UNIT_NAME, "a name of letters, digits, _ . - (no commas or spaces)")
@@ -222,8 +254,13 @@ class Unit:
         for key in ("front_coupling_m", "rear_coupling_m", "rear_end_m", "body_front_m", "body_rear_m"):
             if getattr(self, key) is not None:
                 set_(key, _number(key, getattr(self, key), "position_m"))
-        if self.body_width_m is not None:
-            set_("body_width_m", _number("body_width_m", self.body_width_m, "body_width_m"))
+        for key in ("body_width_m",) + UNIT_ROLL_KEYS:
+            if getattr(self, key) is not None:
+                set_(key, _number(key, getattr(self, key), key))
+        if self.cg_height_m is not None and self.roll_axis_height_m is not None and \
+                self.roll_axis_height_m >= self.cg_height_m:
+            raise VehicleError("roll_axis_height_m", f"roll_axis_height_m must be below cg_height_m "
+                               f"({self.cg_height_m:g} m), got {self.roll_axis_height_m:g} m")
         if (self.body_front_m is None) != (self.body_rear_m is None):
             given, missing = ("body_front_m", "body_rear_m") if self.body_rear_m is None else \
                 ("body_rear_m", "body_front_m")
@@ -237,6 +274,10 @@ class Unit:
         if not axles:
             raise VehicleError("axles", "a unit needs at least one axle, got none")
         set_("axles", axles)
+        unsprung = [a.unsprung_mass_kg for a in axles]
+        if None not in unsprung and sum(unsprung) >= self.mass_kg:
+            raise VehicleError("unsprung_mass_kg", f"unsprung_mass_kg of the axles sum to {sum(unsprung):.6g} kg, "
+                               f"at or above the unit's mass_kg {self.mass_kg:.6g} kg (they are part of it)")
         reach = max(abs(x) for x in [a.x_m for a in axles] + [self.front_coupling_m, self.rear_coupling_m]
                     if x is not None)
         k = math.sqrt(self.yaw_inertia_kg_m2 / self.mass_kg)
@@ -314,6 +355,9 @@ class Vehicle:
             if i < n - 1 and u.rear_coupling_m is None:
                 raise VehicleError("rear_coupling_m", "rear_coupling_m is required on every unit but the last "
                                    f"(unit {i + 1} of {n} couples to the next)", where)
+            for key in ("rear_coupling_height_m", "rear_coupling_roll_stiffness_Nm_per_rad"):
+                if u.rear_coupling_m is None and getattr(u, key) is not None:
+                    raise VehicleError(key, f"{key} must be absent on a unit without a rear coupling", where)
             if i == n - 1 and u.rear_coupling_m is not None:
                 raise VehicleError("rear_coupling_m", "rear_coupling_m must be absent on the last unit "
                                    "(nothing is coupled behind it)", where)
@@ -421,6 +465,7 @@ class Vehicle:
         units = list(self.units[:n_units])
         last = units[-1]
         if last.rear_coupling_m is not None:
-            units[-1] = replace(last, rear_coupling_m=None,
+            units[-1] = replace(last, rear_coupling_m=None, rear_coupling_height_m=None,
+                                rear_coupling_roll_stiffness_Nm_per_rad=None,
                                 rear_end_m=last.rear_end_m if last.rear_end_m is not None else last.rear_coupling_m)
         return replace(self, units=tuple(units), name=name or self.name)

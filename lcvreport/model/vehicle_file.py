@@ -69,7 +69,7 @@ import unicodedata
 from pathlib import Path
 
 from ..util.files import FileInputError, loads_toml, read_text_file
-from .vehicle import Axle, Unit, Vehicle, VehicleError
+from .vehicle import AXLE_ROLL_KEYS, UNIT_ROLL_KEYS, Axle, Unit, Vehicle, VehicleError
 
 #: the format tag of version 1
 FORMAT = "lcv-vehicle/1"
@@ -81,9 +81,11 @@ MAX_DEPTH = 16
 #: keys of the top level, a unit and an axle: (required, optional)
 TOP_KEYS = (("format", "name", "units"), ("description",))
 UNIT_KEYS = (("name", "mass_kg", "yaw_inertia_kg_m2", "axles"),
-             ("front_coupling_m", "rear_coupling_m", "rear_end_m", "body_front_m", "body_rear_m", "body_width_m"))
+             ("front_coupling_m", "rear_coupling_m", "rear_end_m", "body_front_m", "body_rear_m",
+              "body_width_m") + UNIT_ROLL_KEYS)
 AXLE_KEYS = (("name", "x_m", "tires", "cornering_stiffness_N_per_rad", "aligning_stiffness_Nm_per_rad",
-              "longitudinal_stiffness_N", "dual_spacing_m"), ("steered", "static_load_N", "track_width_m"))
+              "longitudinal_stiffness_N", "dual_spacing_m"), ("steered", "static_load_N", "track_width_m")
+             + AXLE_ROLL_KEYS)
 
 
 class VehicleFileError(VehicleError):
@@ -287,7 +289,7 @@ def dumps_vehicle(vehicle: Vehicle, header: str = "", unit_comments: dict | None
         out.append("[[units]]")
         out.append(f"name = {_value(u.name)}")
         for key in ("mass_kg", "yaw_inertia_kg_m2", "front_coupling_m", "rear_coupling_m", "rear_end_m",
-                    "body_front_m", "body_rear_m", "body_width_m"):
+                    "body_front_m", "body_rear_m", "body_width_m") + UNIT_ROLL_KEYS:
             if getattr(u, key) is not None:
                 out.append(f"{key} = {_value(getattr(u, key))}")
         for a in u.axles:

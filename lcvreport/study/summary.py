@@ -73,14 +73,15 @@ def pass_rates(table, criteria, factors, bins: int = 8) -> PassRates:
     overall = []
     judged_all = np.ones(len(table), bool)
     pass_all = np.ones(len(table), bool)
-    for lim in limits:
-        x = table[lim.key].to_numpy(dtype=float)
+    for spec in limits:
+        x = table[spec.key].to_numpy(dtype=float)
+        lim = spec.resolved(lambda k: table[k].to_numpy(dtype=float) if k in table else None)
         judged, ok = judge_values(lim, x, lower_bounds_of(table, lim.key))   # the verdicts of lcv measures
         verdict[lim.key] = (judged, ok)
         judged_all &= judged
         pass_all &= ok
         lo, hi = wilson(int(ok.sum()), int(judged.sum()))
-        overall.append({"limit": lim.text(), "judged": int(judged.sum()), "passed": int(ok.sum()),
+        overall.append({"limit": spec.text(), "judged": int(judged.sum()), "passed": int(ok.sum()),
                         "pass_rate": ok.sum() / judged.sum() if judged.sum() else math.nan, "ci95_low": lo,
                         "ci95_high": hi, "source": lim.source})
     if len(limits) > 1:

@@ -33,6 +33,7 @@ import numpy as np
 from ...ranges import RANGES, RangeError
 from ...units import IN_PER_FT, M_PER_FT, SI, UnitSystem
 from ..vehicle import Vehicle
+from ..linear import linear_model
 from .equations import system_coefficients
 
 #: load conventions (docs/thesis.md)
@@ -145,7 +146,7 @@ def one_percent_rule(vehicle: Vehicle, units, t_sign: float = 1.0, fraction: flo
 
 
 def load_vector(vehicle: Vehicle, loads: ResidualLoads, convention: str = "consistent",
-                units: UnitSystem = SI) -> np.ndarray:
+                units: UnitSystem = SI, model: str = "yaw_plane") -> np.ndarray:
     """Generalized force F of eq. 3.16 / 4.16 from per-axle residual loads.
 
     Parameters
@@ -155,6 +156,8 @@ def load_vector(vehicle: Vehicle, loads: ResidualLoads, convention: str = "consi
     convention : {"consistent", "thesis"}
     units : UnitSystem
         SI (default: row 1 in N, rows 2..N+1 in N*m) or THESIS (lbf, lbf*in).
+    model : str
+        The linear model whose generalized forces these are (default the yaw plane).
 
     Returns
     -------
@@ -163,7 +166,7 @@ def load_vector(vehicle: Vehicle, loads: ResidualLoads, convention: str = "consi
     """
     if convention not in CONVENTIONS:
         raise ValueError(f"convention must be one of {', '.join(CONVENTIONS)}, got {convention!r}")
-    co = system_coefficients(vehicle, units)
+    co = system_coefficients(vehicle, units) if model == "yaw_plane" else linear_model(vehicle, model, units)
     P, T = loads.vectors(vehicle)
     F = co.B_P @ (P / units.force_N) + co.B_T @ (T / units.moment_Nm)
     if convention == "thesis":
@@ -201,9 +204,9 @@ class ResidualSources:
     def __bool__(self) -> bool:
         return bool(self.loads.P_N or self.loads.T_Nm or self.misalignment_rad or self.crossfall_percent)
 
-    def vector(self, vehicle: Vehicle, tire_scale: float = 1.0) -> np.ndarray:
-        """The generalized force F (2N,) of every source, SI (the misalignment's scales
-        with the tire coefficients, the others do not).
+    def vector(self, vehicle: Vehicle, tire_scale: float = 1.0, model: str = "yaw_plane") -> np.ndarray:
+        """The generalized force F (n,) of every source on the linear model ``model``, SI (the
+        misalignment's scales with the tire coefficients, the others do not).
 
         Raises
         ------
@@ -212,8 +215,21 @@ class ResidualSources:
         lcvreport.ranges.RangeError
             A value outside :data:`lcvreport.ranges.RANGES`.
         """
-        co = system_coefficients(vehicle)
+        co = linear_model(vehicle, model)
         P, T = self.loads.vectors(vehicle)
+        eps = self._misalignments(vehicle)
+        c = RANGES["crossfall"].check(self.crossfall_percent, "crossfall")
+        return (co.B_P @ P + co.B_T @ T + tire_scale * (co.B_eps @ eps)
+                + math.sin(math.atan(c / 100.0)) * co.B_crossfall)
+
+    def axle_forces(self, vehicle: Vehicle, tire_scale: float = 1.0) -> np.ndarray:
+        """Each axle's constant lateral tire force of the sources [N]: its P plus ``s C_F eps``
+        (what the load transfer of the yaw-roll model adds to the slip-angle force)."""
+        P, _T = self.loads.vectors(vehicle)
+        cf = np.array([a.cornering_stiffness_axle_N_per_rad for a in vehicle.axles])
+        return P + tire_scale * cf * self._misalignments(vehicle)
+
+    def _misalignments(self, vehicle: Vehicle) -> np.ndarray:
         names = vehicle.axle_names
         unknown = set(self.misalignment_rad) - set(names)
         if unknown:
@@ -221,9 +237,7 @@ class ResidualSources:
         eps = np.array([self.misalignment_rad.get(a, 0.0) for a in names], dtype=float)
         for a, e in zip(names, eps):
             RANGES["misalignment"].check(e, f"misalignment of axle {a}")
-        c = RANGES["crossfall"].check(self.crossfall_percent, "crossfall")
-        return (co.B_P @ P + co.B_T @ T + tire_scale * (co.B_eps @ eps)
-                + math.sin(math.atan(c / 100.0)) * co.B_crossfall)
+        return eps
 
     def describe(self) -> str:
         """The sources in words, for captions and notes."""

@@ -1,0 +1,175 @@
+r"""The roll measures (docs/roll.md#measures): the yaw-roll model's damping, critical speed,
+rearward amplification, transient offtracking, load transfer ratios and roll gains, and the
+static rollover threshold of every roll-coupled group.
+
+A vehicle without roll data has every roll measure null, with the missing key named.
+
+Examples
+--------
+>>> from lcvreport import load_vehicle
+>>> s = roll_summary(load_vehicle("examples/vehicles/b_double.toml"), 25.0)
+>>> round(s.threshold.srt_min_g, 3), len(s.ltr_lane_change)
+(0.48, 1)
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.exact import ManoeuvreError
+from ..model.linear import linear_model
+from ..model.vehicle import Vehicle
+from ..model.yaw_roll.parameters import G_MPS2, missing_roll_data
+from .rollover import RolloverThreshold, rollover_threshold
+from .amplification import single_sine
+from .offtracking import LANE_CHANGE, lane_change_measures
+from .registry import NO_STEER, MeasureCase
+from .stability import CRITICAL_SPEED_MAX_KPH, critical_speed, least_damping
+
+MODEL = "yaw_roll"
+#: the single sine of ltr_single_sine is scaled to this max|a_1| [g]
+LTR_SINGLE_SINE_G = 0.15
+
+ROLLOVER_KEYS = ("srt_g", "srt_rrcu_g", "srt_min_g")
+ROLL_KEYS = ("roll_least_damping_ratio", "roll_critical_speed_kph", "ra_single_sine_roll", "ltr_single_sine",
+             "ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change", "rltr_lane_change", "roll_gain_deg_per_g")
+
+
+def roll_gains(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
+    """Steady-turn roll gain of every unit, signed ``phi_i / (a_1 / g)`` [deg/g] (negative when
+    the unit rolls out of the turn), on the yaw-roll model at ``speed_mps`` [m/s]."""
+    co = linear_model(vehicle, MODEL)
+    A, G = co.state_derivative_maps(speed_mps, tire_scale)
+    x = -np.linalg.solve(A, G @ co.B_delta(tire_scale))          # per radian of steer
+    a1 = float(speed_mps) * x[1]                                  # a_1 = u r_1 at rest in the turn
+    phi = x[co.phi_index:co.phi_index + vehicle.n_units]
+    return np.degrees(phi) / (a1 / G_MPS2)
+
+
+def ltr_peaks(response, n_groups: int) -> list[float]:
+    """max over the response of |LTR| of every group, front to rear [-]."""
+    return [float(x) for x in response.peaks_abs([f"ltr{g + 1}" for g in range(n_groups)])]
+
+
+def ltr_single_sine(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, f_hz: float = LANE_CHANGE[1]):
+    """(RA, |LTR| peaks per group) of the 0.4 Hz single sine on the yaw-roll model, the LTR scaled
+    to ``max|a_1| = 0.15 g`` (the model is linear)."""
+    s = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale, model=MODEL)
+    scale = LTR_SINGLE_SINE_G * G_MPS2 / float(s.peaks[0])
+    groups = len(linear_model(vehicle, MODEL).roll.groups)
+    return s.rearward_amplification, [scale * x for x in ltr_peaks(s.response, groups)]
+
+
+@dataclass(frozen=True)
+class RollSummary:
+    """What ``lcv roll`` shows (docs/roll.md#cli): the threshold of every group, the roll gains,
+    the load transfer ratios and the roll modes' damping at one speed."""
+
+    vehicle: Vehicle
+    speed_mps: float
+    threshold: RolloverThreshold
+    roll_gain_deg_per_g: list
+    ltr_lane_change: list | None
+    ltr_single_sine: list | None
+    roll_least_damping_ratio: float | None
+    roll_critical_speed_kph: float | None
+    reasons: dict
+
+    def to_dict(self) -> dict:
+        """The JSON of ``lcv roll`` (docs/roll.md#cli)."""
+        t = self.threshold
+        return {"speed_mps": self.speed_mps, "groups": t.to_dict(), "srt_min_g": t.srt_min_g,
+                "srt_rrcu_g": t.srt_rrcu_g,
+                "roll_gain_deg_per_g": dict(zip(self.vehicle.unit_names, self.roll_gain_deg_per_g)),
+                "ltr_lane_change": self.ltr_lane_change,
+                "rltr_lane_change": None if self.ltr_lane_change is None else self.ltr_lane_change[-1],
+                "ltr_single_sine": self.ltr_single_sine, "roll_least_damping_ratio": self.roll_least_damping_ratio,
+                "roll_critical_speed_kph": self.roll_critical_speed_kph, "reasons": dict(self.reasons)}
+
+    def plot(self, ax=None):
+        """The a_y - phi curve of every group with each lift-off marked."""
+        return self.threshold.plot(ax)
+
+
+def roll_summary(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RollSummary:
+    """The roll summary of ``vehicle`` at ``speed_mps`` [m/s] (see :class:`RollSummary`).
+
+    Raises
+    ------
+    VehicleError
+        Missing or invalid roll data (naming the unit, the axle and the key).
+    """
+    threshold = rollover_threshold(vehicle)
+    values, reasons = _dynamic(vehicle, float(speed_mps), float(tire_scale))
+    return RollSummary(vehicle, float(speed_mps), threshold, [float(x) for x in roll_gains(vehicle, speed_mps,
+                                                                                          tire_scale)],
+                       values["ltr_lane_change"], values["ltr_single_sine"], values["roll_least_damping_ratio"],
+                       values["roll_critical_speed_kph"], reasons)
+
+
+def _dynamic(vehicle: Vehicle, u: float, s: float) -> tuple[dict, dict]:
+    """The roll family's values and reasons (roll data present)."""
+    values, reasons = dict.fromkeys(ROLL_KEYS), {}
+    zeta, _f = least_damping(vehicle, u, s, model=MODEL)
+    values["roll_least_damping_ratio"] = zeta
+    if zeta is None:
+        reasons["roll_least_damping_ratio"] = "no mode oscillates"
+    crit = critical_speed(vehicle, s, model=MODEL)
+    values["roll_critical_speed_kph"] = crit
+    if crit is None:
+        reasons["roll_critical_speed_kph"] = f"stable at every speed up to {CRITICAL_SPEED_MAX_KPH:g} km/h"
+    if not vehicle.steered_axles:
+        for k in ("ra_single_sine_roll", "ltr_single_sine", "ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change",
+                  "rltr_lane_change", "roll_gain_deg_per_g"):
+            reasons[k] = NO_STEER
+        return values, reasons
+    values["ra_single_sine_roll"], values["ltr_single_sine"] = ltr_single_sine(vehicle, u, s)
+    groups = len(linear_model(vehicle, MODEL).roll.groups)
+    try:
+        lc = lane_change_measures(vehicle, u, s, model=MODEL)
+    except ManoeuvreError as exc:
+        for k in ("ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change", "rltr_lane_change"):
+            reasons[k] = f"undefined: {exc}"
+    else:
+        values["ra_lane_change_roll"], values["hsto_m_roll"] = lc.ra_lane_change, lc.hsto_m
+        values["ltr_lane_change"] = ltr_peaks(lc.response, groups)
+        values["rltr_lane_change"] = values["ltr_lane_change"][-1]
+    gains = roll_gains(vehicle, u, s)
+    values["roll_gain_deg_per_g"] = [float(x) for x in gains] if np.all(np.isfinite(gains)) else None
+    if values["roll_gain_deg_per_g"] is None:
+        reasons["roll_gain_deg_per_g"] = "undefined: the steady turn has no lateral acceleration"
+    return values, reasons
+
+
+def _no_roll(keys, vehicle: Vehicle):
+    why = missing_roll_data(vehicle)
+    if why is None:
+        return None
+    return dict.fromkeys(keys), dict.fromkeys(keys, f"undefined: no roll data: {why}")
+
+
+def roll_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``roll`` family: the yaw-roll model's dynamic measures at the case's speed."""
+    missing = _no_roll(ROLL_KEYS, case.vehicle)
+    if missing is not None:
+        return missing
+    return _dynamic(case.vehicle, case.speed_mps, case.tire_scale)
+
+
+def rollover_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``rollover`` family: the static rollover threshold of every group."""
+    missing = _no_roll(ROLLOVER_KEYS, case.vehicle)
+    if missing is not None:
+        return missing
+    t = rollover_threshold(case.vehicle)
+    return {"srt_g": [g.srt_g for g in t.groups], "srt_rrcu_g": t.srt_rrcu_g, "srt_min_g": t.srt_min_g}, {}
+
+
+def unstable_at_rest_note(threshold: RolloverThreshold) -> str | None:
+    """The line saying which groups cannot hold their sprung weight at rest (SRT 0), or None."""
+    weak = [", ".join(g.units) for g in threshold.groups if not g.stable_at_rest]
+    if not weak:
+        return None
+    return (f"note: the roll stiffness of ({'; '.join(weak)}) cannot hold its sprung weight at rest (the group's "
+            "roll stiffness matrix is not positive definite): SRT 0 and an unstable roll mode")
