@@ -137,8 +137,8 @@ def build_parser() -> argparse.ArgumentParser:
                           "CG accelerations, axle load transfers and load transfer ratios; needs the roll keys)")
     sim.add_argument("--dt", default=0.01, type=_ranged("output_step", what="output step in s"), metavar="H",
                      help=f"output step [s], in {_help_range('output_step')}; must divide t-end; default 0.01")
-    mea = sub.add_parser("measures", help="yaw-plane measures: damping, RA, YDC, HSTO, HSSO, trim, the low-speed "
-                                          "turn (defined in docs/measures.md)")
+    mea = sub.add_parser("measures", help="the measures: damping, RA, YDC, HSTO, HSSO, trim, the low-speed turn, "
+                                          "roll (SRT, LTR, roll gains; with roll data) (defined in docs/measures.md)")
     source(mea)
     g = mea.add_mutually_exclusive_group(required=True)
     g.add_argument("--speed-kph", metavar="V", help="forward speed [km/h], or a sweep START:STOP:STEP")

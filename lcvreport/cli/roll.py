@@ -45,7 +45,9 @@ def _cmd_roll(args, out: _Out) -> int:
     note = unstable_at_rest_note(s.threshold)
     if note:
         out.line(f"  {note}")
-    for name, gain in doc["roll_gain_deg_per_g"].items():
+    if doc["roll_gain_deg_per_g"] is None:
+        out.line(f"  roll gains not computed: {_line(doc['reasons'].get('roll_gain_deg_per_g', ''))}")
+    for name, gain in (doc["roll_gain_deg_per_g"] or {}).items():
         out.line(f"  roll gain, {name:<16} {fmt(gain, '.3f'):>8} deg/g")
     for key, label in (("ltr_lane_change", "LTR, lane change 0.15 g 0.4 Hz"),
                        ("ltr_single_sine", "LTR, single sine 0.4 Hz, 0.15 g")):

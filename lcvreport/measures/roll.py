@@ -69,7 +69,7 @@ class RollSummary:
     vehicle: Vehicle
     speed_mps: float
     threshold: RolloverThreshold
-    roll_gain_deg_per_g: list
+    roll_gain_deg_per_g: list | None
     ltr_lane_change: list | None
     ltr_single_sine: list | None
     roll_least_damping_ratio: float | None
@@ -81,7 +81,8 @@ class RollSummary:
         t = self.threshold
         return {"speed_mps": self.speed_mps, "groups": t.to_dict(), "srt_min_g": t.srt_min_g,
                 "srt_rrcu_g": t.srt_rrcu_g,
-                "roll_gain_deg_per_g": dict(zip(self.vehicle.unit_names, self.roll_gain_deg_per_g)),
+                "roll_gain_deg_per_g": None if self.roll_gain_deg_per_g is None else dict(
+                    zip(self.vehicle.unit_names, self.roll_gain_deg_per_g)),
                 "ltr_lane_change": self.ltr_lane_change,
                 "rltr_lane_change": None if self.ltr_lane_change is None else self.ltr_lane_change[-1],
                 "ltr_single_sine": self.ltr_single_sine, "roll_least_damping_ratio": self.roll_least_damping_ratio,
@@ -102,8 +103,7 @@ def roll_summary(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) ->
     """
     threshold = rollover_threshold(vehicle)
     values, reasons = _dynamic(vehicle, float(speed_mps), float(tire_scale))
-    return RollSummary(vehicle, float(speed_mps), threshold, [float(x) for x in roll_gains(vehicle, speed_mps,
-                                                                                          tire_scale)],
+    return RollSummary(vehicle, float(speed_mps), threshold, values["roll_gain_deg_per_g"],
                        values["ltr_lane_change"], values["ltr_single_sine"], values["roll_least_damping_ratio"],
                        values["roll_critical_speed_kph"], reasons)
 

@@ -104,7 +104,7 @@ def _positive_definite(K: np.ndarray) -> bool:
 def group_threshold(vehicle: Vehicle, rp: RollParameters, units: tuple) -> GroupThreshold:
     """The threshold of the group ``units`` (0-based unit indices, consecutive)."""
     g = G_MPS2
-    first, last = units[0], units[-1]
+    first = units[0]
     nG = len(units)
     local = {u: k for k, u in enumerate(units)}
     axles = [j for j, i in enumerate(rp.axle_unit) if i in local]

@@ -33,6 +33,7 @@ Examples
 from __future__ import annotations
 
 import importlib
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -197,3 +198,23 @@ class LinearModel:
         V = self.velocity_map(speed_mps)
         u = float(self.units.speed(speed_mps))
         return V @ A + u * self.yaw_rate_map(), V @ G
+
+
+@dataclass(frozen=True, eq=False)
+class LinearCoefficients(LinearModel):
+    """The coefficients every linear model holds (see :class:`LinearModel`): the vehicle, the unit
+    system, ``M0, M1, S0, Sinv, Su, Skin`` (n, n), ``Bdelta`` (n,), ``B_P``, ``B_T`` (n, n_axles);
+    a model's class adds its own fields after these."""
+
+    vehicle: object
+    units: object
+    M0: np.ndarray
+    M1: np.ndarray
+    S0: np.ndarray
+    Sinv: np.ndarray
+    Su: np.ndarray
+    Skin: np.ndarray
+    Bdelta: np.ndarray
+    B_P: np.ndarray
+    B_T: np.ndarray
+

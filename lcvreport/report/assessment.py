@@ -34,7 +34,7 @@ from ..plotting.frequency import fig_damping_over_speed, fig_frequency, fig_root
 from ..plotting.time import fig_lane_change, fig_pulse
 from ..plotting.vehicle import fig_mode_shape, fig_vehicle
 from ..tracking.tires import AxleSensitivity, conicity_sensitivity
-from ..units import kph_to_mps
+from ..units import kph_to_mps, mps_to_kph
 
 #: speed range of the root locus and of the damping curve [km/h] (docs/reports.md)
 SWEEP_KPH = (10.0, 130.0)
@@ -305,6 +305,59 @@ class Assessment:
 
     def fig_swept_path(self):
         return self.low_speed_turn.plot(f"{self.vehicle.name}: low-speed 90° turn, outside steer wheel on R = 12.5 m")
+
+    # ------------------------------------------------------------------ roll (docs/roll.md)
+    @cached_property
+    def roll(self):
+        """:class:`lcvreport.measures.roll.RollSummary` at the report's speed, or why it is not
+        computed (str: the missing roll key)."""
+        from ..measures.roll import roll_summary
+        from ..model.vehicle import VehicleError
+        try:
+            return roll_summary(self.vehicle, self.speed_mps)
+        except VehicleError as exc:
+            return f"no roll data: {exc}"
+
+    def roll_threshold_rows(self) -> list[dict]:
+        """Per roll-coupled group: its units, SRT [g] and every axle's lift-off [g]."""
+        rows = []
+        for k, g in enumerate(self.roll.threshold.groups, 1):
+            lifts = ", ".join(f"{axle} {at:.3f}" if at is not None else f"{axle} none"
+                              for axle, at in g.lift_off_g.items())
+            rows.append({"group": k, "units": ", ".join(g.units), "SRT [g]": g.srt_g, "lift-off [g]": lifts,
+                         "stable at rest": "yes" if g.stable_at_rest else "no: SRT 0"})
+        return rows
+
+    def roll_unit_rows(self) -> list[dict]:
+        """Per unit: its roll gain [deg/g] and its group's LTR in the lane change and the single sine."""
+        s = self.roll
+        group = {u: k for k, g in enumerate(s.threshold.groups) for u in g.units}
+        rows = []
+        gains = s.roll_gain_deg_per_g or [None] * self.vehicle.n_units
+        for name, gain in zip(self.vehicle.unit_names, gains):
+            k = group[name]
+            rows.append({"unit": name, "group": k + 1, "roll gain [deg/g]": gain,
+                         "LTR, lane change [-]": None if s.ltr_lane_change is None else s.ltr_lane_change[k],
+                         "LTR, single sine [-]": None if s.ltr_single_sine is None else s.ltr_single_sine[k]})
+        return rows
+
+    def roll_mode_rows(self, count: int = 4) -> list[dict]:
+        """The ``count`` least damped oscillatory modes of the yaw-roll model at the report's speed."""
+        from ..analysis.modes import eigenvalues
+        ev = eigenvalues(self.vehicle, self.speed_mps, model="yaw_roll")
+        osc = sorted((lam for lam in ev if lam.imag > 0), key=lambda lam: -lam.real / abs(lam))
+        return [{"mode": k + 1, "real part [1/s]": lam.real, "frequency [Hz]": lam.imag / (2 * np.pi),
+                 "damping ratio [-]": -lam.real / abs(lam)} for k, lam in enumerate(osc[:count])]
+
+    def fig_rollover(self):
+        return self.roll.plot()
+
+    def fig_ltr_lane_change(self):
+        from ..measures.offtracking import lane_change_measures
+        from ..plotting.roll import plot_ltr
+        r = lane_change_measures(self.vehicle, self.speed_mps, model="yaw_roll").response
+        return plot_ltr(r, len(self.roll.threshold.groups), f"{self.vehicle.name}: load transfer ratio per "
+                        f"roll-coupled group, lane change 0.15 g 0.4 Hz at {mps_to_kph(self.speed_mps):.0f} km/h")
 
     # ------------------------------------------------------------------ straight-line tracking (docs/tracking.md)
     def _tire_force(self) -> np.ndarray:

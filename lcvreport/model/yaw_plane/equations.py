@@ -39,14 +39,14 @@ from functools import lru_cache
 import numpy as np
 
 from ...units import SI, UnitSystem
-from ..linear import LinearModel, check_speed, check_tire_scale
+from ..linear import LinearCoefficients, check_speed, check_tire_scale
 from ..vehicle import Vehicle
 from .outputs import point_lateral_map
 from .states import state_names
 
 
 @dataclass(frozen=True, eq=False)
-class SystemCoefficients(LinearModel):
+class SystemCoefficients(LinearCoefficients):
     r"""Speed- and tire-scale-free coefficients of the matrices of one vehicle.
 
     ``M(u) = M0 + u*M1``;  ``S(u, s) = s*(S0 + Sinv/u) + Skin + u*Su``;
@@ -76,17 +76,6 @@ class SystemCoefficients(LinearModel):
         d v_i / d (u theta_k): 1 for every joint ahead of unit i.
     """
 
-    vehicle: Vehicle
-    units: UnitSystem
-    M0: np.ndarray
-    M1: np.ndarray
-    S0: np.ndarray
-    Sinv: np.ndarray
-    Su: np.ndarray
-    Skin: np.ndarray
-    Bdelta: np.ndarray
-    B_P: np.ndarray
-    B_T: np.ndarray
     Jv: np.ndarray
     Jr: np.ndarray
     K: np.ndarray

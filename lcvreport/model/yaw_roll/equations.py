@@ -39,7 +39,7 @@ from functools import lru_cache
 import numpy as np
 
 from ...units import SI, UnitSystem
-from ..linear import LinearModel
+from ..linear import LinearCoefficients
 from ..vehicle import Vehicle
 from ..yaw_plane.equations import kinematic_jacobians
 from ..yaw_plane.outputs import point_lateral_map
@@ -48,7 +48,7 @@ from .parameters import G_MPS2, RollParameters, roll_parameters
 
 
 @dataclass(frozen=True, eq=False)
-class YawRollCoefficients(LinearModel):
+class YawRollCoefficients(LinearCoefficients):
     r"""Speed- and tire-scale-free coefficients of the yaw-roll model of one vehicle (SI).
 
     Attributes (besides :class:`~lcvreport.model.linear.LinearModel`'s)
@@ -63,17 +63,6 @@ class YawRollCoefficients(LinearModel):
         ``Kphi``: the roll moments on the sprung masses per radian of roll [N*m/rad].
     """
 
-    vehicle: Vehicle
-    units: UnitSystem
-    M0: np.ndarray
-    M1: np.ndarray
-    S0: np.ndarray
-    Sinv: np.ndarray
-    Su: np.ndarray
-    Skin: np.ndarray
-    Bdelta: np.ndarray
-    B_P: np.ndarray
-    B_T: np.ndarray
     B_eps: np.ndarray
     B_crossfall: np.ndarray
     Jv: np.ndarray

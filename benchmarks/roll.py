@@ -1,0 +1,94 @@
+"""Benchmark: roll (docs/roll.md) -- ``lcv roll`` of a 6-unit vehicle with start-up, and the roll
+measure set against the yaw-plane measure set of the same vehicle.
+
+The 6-unit vehicle is the AU-NCAT triple with the examples' assumed roll data
+(``examples/vehicles/make_examples.py``: ROLL_UNITS, ROLL_AXLES), written to a temporary file.
+The comparison is the same vehicle without its roll keys (the roll families then return at
+once): what the roll families add to ``measure_set``.  Best of ``REPEATS``; one BLAS thread.
+Targets (issue 31): ``lcv roll`` <= 0.5 s with start-up; the roll measure set <= 3x the yaw-plane one.
+
+    python benchmarks/roll.py
+"""
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")    # before numpy is imported
+
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from dataclasses import replace  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "examples" / "vehicles"))
+
+import make_examples  # noqa: E402
+
+from lcvreport import load_preset  # noqa: E402
+from lcvreport.measures.measure_set import measure_set  # noqa: E402
+from lcvreport.model.vehicle_file import dumps_vehicle  # noqa: E402
+
+REPEATS = 5
+SPEED_MPS = 88 / 3.6
+
+
+def triple_with_roll():
+    """AU-NCAT with the examples' assumed roll data (fifth wheels roll-coupled, drawbars roll-free)."""
+    roll = make_examples.ROLL_UNITS
+    roll.update({"tractor": roll["tractor"], "trailer1": roll["trailer1"], "dolly1": roll["dolly"],
+                 "trailer2": (2.00, 0.75, 2.4, (0.90, 0.0)), "dolly2": roll["dolly"], "trailer3": roll["trailer2"]})
+    return make_examples.with_roll(load_preset("aucnat"))
+
+
+def without_roll(vehicle):
+    keys = dict.fromkeys(("cg_height_m", "roll_axis_height_m", "roll_inertia_kg_m2", "rear_coupling_height_m",
+                          "rear_coupling_roll_stiffness_Nm_per_rad"))
+    return replace(vehicle, units=tuple(replace(u, **keys, axles=tuple(replace(
+        a, roll_stiffness_Nm_per_rad=None, roll_damping_Nms_per_rad=None, unsprung_mass_kg=None) for a in u.axles))
+        for u in vehicle.units))
+
+
+def best(fn, repeats=REPEATS):
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def main() -> None:
+    v = triple_with_roll()
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "triple_roll.toml"
+        path.write_text(dumps_vehicle(v), encoding="utf-8")
+        cmd = [sys.executable, "-m", "lcvreport.cli", "roll", "--vehicle", str(path), "--speed-kph", "88", "--json"]
+        wall = best(lambda: subprocess.run(cmd, check=True, capture_output=True))
+        start = best(lambda: subprocess.run([sys.executable, "-m", "lcvreport.cli", "presets"], check=True,
+                                            capture_output=True))
+    print(f"lcv roll, 6 units, with start-up: {wall:.3f} s (target <= 0.5 s); lcv presets (start-up alone) "
+          f"{start:.3f} s")
+    plain = without_roll(v)
+    # fresh vehicle objects each time: nothing cached between repeats
+    t_roll = best(lambda: measure_set(replace(v, name=f"r{time.perf_counter_ns()}"), SPEED_MPS))
+    t_yaw = best(lambda: measure_set(replace(plain, name=f"p{time.perf_counter_ns()}"), SPEED_MPS))
+    print(f"measure_set with roll {t_roll * 1e3:.1f} ms, without {t_yaw * 1e3:.1f} ms: ratio {t_roll / t_yaw:.2f} "
+          "(target <= 3; both include the low-speed turn)")
+    from lcvreport.measures.registry import FAMILIES, MeasureCase
+
+    def families(names, vehicle):
+        case = MeasureCase(replace(vehicle, name=f"f{time.perf_counter_ns()}"), SPEED_MPS, 1.0, 0.4)
+        for name in names:
+            FAMILIES[name].compute(case)
+    roll = ("rollover", "roll")
+    yaw = tuple(n for n in FAMILIES if n not in roll + ("low_speed_turn", "trim"))
+    t_r, t_y = best(lambda: families(roll, v)), best(lambda: families(yaw, v))
+    print(f"the roll families alone {t_r * 1e3:.1f} ms, the yaw-plane families but the turn {t_y * 1e3:.1f} ms: "
+          f"ratio {t_r / t_y:.2f}")
+
+
+if __name__ == "__main__":
+    main()
