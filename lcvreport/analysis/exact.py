@@ -40,9 +40,9 @@ from ..manoeuvres.steer import SteerInput
 from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.outputs import rear_end_weights
+from ..util.threads import one_blas_thread
 from .discretize import augmented_state_matrix
 from .extrema import _hermite_roots, _quintic, _scan
-
 
 
 class ManoeuvreError(ValueError):
@@ -267,6 +267,7 @@ def _steer_axle_maps(vehicle, speed_mps, tire_scale, model: str = "yaw_plane"):
     return A, b, Cs, float(Js @ b)
 
 
+@one_blas_thread
 def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float, dt: float,
              F: np.ndarray | None = None, tire_scale: float = 1.0, t_start: float = 0.0,
              state: np.ndarray | None = None, model: str = "yaw_plane",

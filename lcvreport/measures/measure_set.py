@@ -28,6 +28,7 @@ from ..model.linear import linear_model
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.loads import load_vector, one_percent_rule
 from ..units import mps_to_kph
+from ..util.threads import one_blas_thread
 from .registry import FAMILIES, MEASURES, MeasureCase
 
 
@@ -144,6 +145,7 @@ def residual_force(vehicle: Vehicle, load_units=None, sources=None, tire_scale: 
     return F
 
 
+@one_blas_thread
 def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, load_units=None,
                 f_hz: float = RA_FREQUENCY_HZ, sources=None) -> MeasureSet:
     """Every measure of the registry (``docs/measures.md``) of ``vehicle`` at ``speed_mps`` [m/s]:
@@ -187,6 +189,7 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
                       trim=case.shared.get("trim"))
 
 
+@one_blas_thread
 def batch_measures(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None,
                    F=None) -> dict:
     """The batched measures of every variant of ``batch`` as columns (a dict of arrays of length

@@ -21,10 +21,11 @@ from ..analysis.exact import ManoeuvreError
 from ..model.linear import linear_model
 from ..model.vehicle import Vehicle
 from ..model.yaw_roll.parameters import G_MPS2, missing_roll_data
-from .rollover import RolloverThreshold, rollover_threshold
+from ..util.threads import one_blas_thread
 from .amplification import single_sine
 from .offtracking import LANE_CHANGE, lane_change_measures
 from .registry import NO_STEER, MeasureCase
+from .rollover import RolloverThreshold, rollover_threshold
 from .stability import CRITICAL_SPEED_MAX_KPH, critical_speed, least_damping
 
 MODEL = "yaw_roll"
@@ -93,6 +94,7 @@ class RollSummary:
         return self.threshold.plot(ax)
 
 
+@one_blas_thread
 def roll_summary(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RollSummary:
     """The roll summary of ``vehicle`` at ``speed_mps`` [m/s] (see :class:`RollSummary`).
 

@@ -30,6 +30,7 @@ from ..model.linear import check_tire_scale
 from ..model.vehicle import Vehicle
 from ..ranges import RANGES
 from ..units import kph_to_mps, mps_to_kph
+from ..util.threads import one_blas_thread
 from .registry import MeasureCase
 
 #: upper end of the critical-speed search [km/h]
@@ -53,6 +54,7 @@ def least_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
     return float(zeta[k]), float(osc[k].imag / (2 * np.pi))
 
 
+@one_blas_thread
 def critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: float = U_MIN_DEFAULT_MPS,
                    u_max_kph: float = CRITICAL_SPEED_MAX_KPH, model: str = "yaw_plane") -> float | None:
     """Lowest speed [km/h] in ``(u_min, u_max]`` where ``max Re(lambda) >= 0`` (of the linear
