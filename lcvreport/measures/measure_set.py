@@ -190,6 +190,33 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
 
 
 @one_blas_thread
+def measure_values(vehicle: Vehicle, speed_mps: float, keys, tire_scale: float = 1.0, load_units=None,
+                   f_hz: float = RA_FREQUENCY_HZ, sources=None) -> dict:
+    """The values of the registry keys ``keys`` only, as :func:`measure_set` gives them (None
+    where undefined), computing just their families (and those they take a result from: the yaw
+    damping compares with the least damping ratio) -- what a study computes case by case.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> v = load_preset("tractor_semitrailer")
+    >>> measure_values(v, 24.4, ["hsso_m"])["hsso_m"] == measure_set(v, 24.4).hsso_m
+    True
+    """
+    units = tuple(load_units) if load_units else ()
+    case = MeasureCase(vehicle, float(speed_mps), float(tire_scale), float(f_hz),
+                       residual_force(vehicle, units, sources, tire_scale))
+    needed = {MEASURES[k].family for k in keys if MEASURES[k].family}
+    if "yaw_damping" in needed:
+        needed.add("least_damping")
+    values = {}
+    for name, family in FAMILIES.items():
+        if name in needed and family.applies(case):
+            values.update(family.compute(case)[0])
+    return {k: values.get(k) for k in keys}
+
+
+@one_blas_thread
 def batch_measures(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0, f_hz: float | None = None,
                    F=None) -> dict:
     """The batched measures of every variant of ``batch`` as columns (a dict of arrays of length

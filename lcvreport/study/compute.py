@@ -21,11 +21,11 @@ import numpy as np
 
 from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ
-from ..measures.measure_set import measure_set
+from ..measures.measure_set import measure_values
 from ..measures.registry import BATCHED as BATCH_GROUPS
 from ..measures.registry import FAMILIES, MeasureCase
 from ..model.linear import linear_model
-from .spec import BATCHED, Study
+from .spec import BATCHED, ROLL_PARAMETERS, Study
 
 
 def compute_chunk(study: Study, case_ids) -> dict:
@@ -53,7 +53,8 @@ def compute_chunk(study: Study, case_ids) -> dict:
         uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
         for g, (u, ts) in enumerate(uniq):
             rows = np.flatnonzero(inverse.ravel() == g)
-            values = {k: arr[rows] for k, arr in params.items()}
+            values = {k: arr[rows] for k, arr in params.items()        # the yaw plane reads no roll key
+                      if k.split(".", 1)[1] not in ROLL_PARAMETERS}
             batch = VariantBatch(v, values)
             for group in groups:
                 case = MeasureCase(v, float(u), float(ts), RA_FREQUENCY_HZ, None if F is None else F[rows])
@@ -65,9 +66,9 @@ def compute_chunk(study: Study, case_ids) -> dict:
     if rest:
         for k, case_id in enumerate(ids):
             vehicle, speed_mps, kwargs = study.case(int(case_id))
-            ms = measure_set(vehicle, speed_mps, **kwargs)
+            values = measure_values(vehicle, speed_mps, rest, **kwargs)     # their families only
             for m in rest:
-                value = ms.value(m)
+                value = values.get(m)
                 cols[m][k] = np.nan if value is None else float(value)
     return cols
 

@@ -18,7 +18,9 @@ A study is a TOML file::
 Factors: ``speed_kph`` (km/h; or ``speed_mps``), ``tire_scale`` (measure_set's factor on every
 tire coefficient), scale factors ``<unit>.mass_scale``, ``<unit>.yaw_inertia_scale`` and
 ``<unit or axle>.cornering_stiffness_scale`` / ``.aligning_stiffness_scale`` /
-``.longitudinal_stiffness_scale`` (a unit name scales all its axles); load cases ``load_units``
+``.longitudinal_stiffness_scale`` (a unit name scales all its axles), and on a vehicle with roll
+data ``<unit>.cg_height_scale``, ``.roll_inertia_scale``, ``.coupling_roll_stiffness_scale``,
+``<unit or axle>.roll_stiffness_scale``, ``.roll_damping_scale``; load cases ``load_units``
 (values: lists of units carrying the 1 % rule, ``[]`` for none); residual sources ``P_<axle>_N``,
 ``T_<axle>_Nm``, ``eps_<axle>_rad`` (misalignment) and ``crossfall_percent`` (docs/manoeuvres.md;
 they act on the trim measures ``trim.delta_rad`` and ``trim.offtracking_m``).  A factor has ``values``
@@ -61,10 +63,17 @@ MEASURES = tuple(CRITERIA_KEYS)
 #: the trim's measures: need a residual source (a load case or a residual-source factor)
 TRIM = _BATCH_GROUPS["trim"]
 DEFAULT_MEASURES = tuple(k for k in BATCHED if k not in TRIM and k != "yaw_damping_lower_bound")
-UNIT_SCALES = {"mass_scale": "mass_kg", "yaw_inertia_scale": "yaw_inertia_kg_m2"}
+UNIT_SCALES = {"mass_scale": "mass_kg", "yaw_inertia_scale": "yaw_inertia_kg_m2",
+               # roll (docs/roll.md): on a vehicle with the roll keys
+               "cg_height_scale": "cg_height_m", "roll_inertia_scale": "roll_inertia_kg_m2",
+               "coupling_roll_stiffness_scale": "rear_coupling_roll_stiffness_Nm_per_rad"}
 AXLE_SCALES = {"cornering_stiffness_scale": "cornering_stiffness_N_per_rad",
                "aligning_stiffness_scale": "aligning_stiffness_Nm_per_rad",
-               "longitudinal_stiffness_scale": "longitudinal_stiffness_N"}
+               "longitudinal_stiffness_scale": "longitudinal_stiffness_N",
+               "roll_stiffness_scale": "roll_stiffness_Nm_per_rad", "roll_damping_scale": "roll_damping_Nms_per_rad"}
+#: the scaled parameters only the roll measures read (the yaw-plane batch leaves them out)
+ROLL_PARAMETERS = ("cg_height_m", "roll_inertia_kg_m2", "rear_coupling_roll_stiffness_Nm_per_rad",
+                   "roll_stiffness_Nm_per_rad", "roll_damping_Nms_per_rad")
 PLAIN_FACTORS = ("speed_kph", "speed_mps", "tire_scale", "crossfall_percent", "load_units")
 #: residual-source factors: name prefix and suffix -> (ranges key, what)
 RESIDUALS = {("P_", "_N"): "residual_force", ("T_", "_Nm"): "residual_moment", ("eps_", "_rad"): "misalignment"}
@@ -220,6 +229,14 @@ class Study:
                     raise StudyError(f"factors.{used[0] if used else pname}: case {int(ids[k])} makes {pname} "
                                      f"{vals[k]:.6g} {r.unit} ({given}); {key} must be in {r.text()}")
             for u in self.vehicle.units:
+                h = params.get(f"{u.name}.cg_height_m")
+                if h is not None and u.roll_axis_height_m is not None:
+                    bad = np.flatnonzero(~(np.asarray(h, dtype=float) > u.roll_axis_height_m))
+                    if bad.size:
+                        i = int(bad[0])
+                        raise StudyError(f"factors.{u.name}.cg_height_scale: case {int(ids[i])} puts the CG of "
+                                         f"{u.name} at {float(h[i]):.6g} m, not above its roll axis "
+                                         f"({u.roll_axis_height_m:g} m)")
                 m = np.asarray(params.get(f"{u.name}.mass_kg", u.mass_kg), dtype=float)
                 inertia = np.asarray(params.get(f"{u.name}.yaw_inertia_kg_m2", u.yaw_inertia_kg_m2), dtype=float)
                 reach = max(abs(x) for x in [a.x_m for a in u.axles] + [u.front_coupling_m, u.rear_coupling_m]
@@ -415,6 +432,16 @@ def _factor(vehicle: Vehicle, name: str, spec) -> Factor:
                              f"T_<axle>_Nm, eps_<axle>_rad, <unit>.{{{','.join(UNIT_SCALES)}}} (units: "
                              f"{', '.join(sorted(units))}), <unit or axle>.{{{','.join(AXLE_SCALES)}}} (axles: "
                              f"{', '.join(sorted(axles))})")
+    if name not in PLAIN_FACTORS and not signed:
+        owner, _, key = name.partition(".")
+        pkey = UNIT_SCALES.get(key) or AXLE_SCALES[key]
+        targets = [u for u in vehicle.units if u.name == owner] if key in UNIT_SCALES else \
+            [a for u in vehicle.units for a in (u.axles if u.name == owner else [a for a in u.axles
+                                                                                 if a.name == owner])]
+        if pkey in ROLL_PARAMETERS:
+            missing = [t.name for t in targets if getattr(t, pkey) is None]
+            if missing:
+                raise StudyError(f"{where}: {', '.join(missing)} has no {pkey} (a roll key, docs/roll.md) to scale")
     if not isinstance(spec, dict):
         raise StudyError(f"{where} must be a table with values = [...] or distribution = ..., got {spec!r}")
     unknown = set(spec) - {"values", "distribution", "low", "high", "mean", "sd"}
