@@ -303,7 +303,7 @@ def test_assessment_captions_name_the_vehicle_and_the_speed(assessment):
                                                                        html, flags=re.S)]
     assert captions and all(name in c for _n, c in captions)
     assert sum("88 km/h" in c for _n, c in captions) >= len(captions) - 1   # Figure 1 is the drawing
-    assert f"Yaw-plane assessment of {name} at 88 km/h" in html
+    assert f"Yaw-plane and roll assessment of {name} at 88 km/h" in html
 
 
 @pytest.mark.xdist_group("assessment")

@@ -183,6 +183,37 @@ def test_the_load_transfer_is_the_axle_balance():
     assert out["ltr1"] == pytest.approx(ltr, rel=1e-12)
 
 
+def test_the_load_transfers_balance_the_whole_units_roll_moment():
+    """The physics, not the formula: about the unit's centre line at the ground, the wheels'
+    vertical loads (sum of T dF_z), the sprung weight displaced by its roll and the d'Alembert
+    moments of both masses and of the sprung mass's rotation balance at every instant:
+    sum T dF_z = m_s g e phi - h m_s a_s - h_r m_u a - I_x p' + I_xz r' (one unit, random state
+    and steer, a yaw-roll product included; the tire forces act at the ground and put no moment)."""
+    v = _vehicle("b_double").truncated(1)
+    u = 19.0
+    co = linear_model(v, "yaw_roll")
+    rp = roll_parameters(v)
+    rng = np.random.default_rng(11)
+    for _ in range(5):
+        x = rng.normal(scale=0.02, size=co.n_states)
+        delta = float(rng.normal(scale=0.01))
+        names, X, XD, D, _O = co.extra_signals(u)
+        A, Gm = co.state_derivative_maps(u)
+        xdot = A @ x + Gm @ co.B_delta() * delta
+        out = dict(zip(names, X @ x + XD @ xdot + D * delta))
+        Ca, Da = co.acceleration_maps(u)
+        a = float(Ca[0] @ x + Da[0] @ co.B_delta() * delta)
+        phi, p_dot, r_dot = x[3], xdot[2], xdot[1]
+        ms, mu = rp.ms_kg[0], rp.m_kg[0] - rp.ms_kg[0]
+        a_s = a + rp.e_m[0] * p_dot
+        moment = (ms * G * rp.e_m[0] * phi - rp.h_m[0] * ms * a_s - rp.hr_m[0] * mu * a - rp.Ix_kg_m2[0] * p_dot
+                  + rp.Ixz_kg_m2[0] * r_dot)
+        wheels = sum(rp.T_m[j] * out[f"dFz_{name}"] for j, name in enumerate(v.axle_names))
+        # terms of ~1e4 N*m cancelling to the result: to 1e-9 of the largest term
+        scale = max(abs(ms * G * rp.e_m[0] * phi), abs(rp.h_m[0] * ms * a_s), abs(rp.Ix_kg_m2[0] * p_dot))
+        assert abs(wheels - moment) <= 1e-9 * scale, (wheels, moment)
+
+
 def _reduced(vehicle):
     """Roll data with e = 0, the couplings at the roll axes, no yaw-roll product: W terms vanish."""
     rp = roll_parameters(vehicle)

@@ -165,7 +165,7 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
                 "criteria_file": None if criteria_file is None else str(Path(criteria_file).resolve()),
                 "load_units": list(load_units) if load_units else None, "tracking": tracking}
 
-    title = f"Yaw-plane assessment of {vehicle.name} at {speed_kph:g} km/h"
+    title = f"Yaw-plane and roll assessment of {vehicle.name} at {speed_kph:g} km/h"
     intro = (f"Linear yaw-plane model of *{md_text(vehicle.name)}* ({vehicle.n_units} units: "
              f"{md_text(', '.join(vehicle.unit_names))}){' from ' + md_text(source) if source else ''}, assessed "
              f"at {speed_kph:g} km/h (SI units; speeds in km/h). Written by lcvreport {version} on {{stamp}}.")

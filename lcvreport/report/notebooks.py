@@ -171,7 +171,7 @@ NOTEBOOKS = (
 
 
 #: the assessment report's notebook
-ASSESSMENT = NotebookSpec("assessment", "assessment", "Yaw-plane assessment",
+ASSESSMENT = NotebookSpec("assessment", "assessment", "Yaw-plane and roll assessment",
                           {**_COMMON, "preset": lambda n, v, c: None, "vehicle_file": _vehicle_file,
                            "source": _text_or_none, "residuals": _residuals, "criteria_file": _text_or_none,
                            "tracking": _tracking,
