@@ -28,6 +28,8 @@ lateral_acceleration   m/s^2          [-20, 20]           a lane change's A0 (2 
 misalignment           rad            [-0.05, 0.05]       thrust angle of an axle (2.9 deg;
                                                           real ones are below 0.5 deg)
 crossfall              %              [-20, 20]           road crossfall (crown ~2 %)
+lane_change_ay         g              (0, 2]              a measure's lane change A0
+steady_turn_radius     m              [20, 10000]         the HSSO turn (393 m by default)
 =====================  =============  ==================  ==============================
 
 The vehicle-file limits (:data:`VEHICLE`) are as generous: they exist so that a
@@ -153,6 +155,10 @@ RANGES: dict[str, Range] = dict([
     ("misalignment", Range("misalignment", "rad", -0.05, 0.05,
                            description="axle misalignment (thrust angle), nose-right positive (2.9 deg)")),
     ("crossfall", Range("crossfall", "%", -20.0, 20.0, description="road crossfall, positive falling toward +y")),
+    ("lane_change_ay", Range("lane change A0", "g", 0.0, 2.0, low_open=True,
+                             description="amplitude of the steered axle's lateral acceleration in a lane change")),
+    ("steady_turn_radius", Range("steady turn radius", "m", 20.0, 10000.0,
+                                 description="radius of the high-speed steady turn (u/R the tractor's yaw rate)")),
     ("turn_radius", Range("turn radius", "m", 2.0, 100.0,
                           description="radius of the outside steer wheel's path in the low-speed turn")),
     ("turn_angle", Range("turn angle", "deg", 0.0, 3600.0, low_open=True,

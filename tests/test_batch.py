@@ -185,10 +185,12 @@ def test_batched_single_sine_is_the_one_variant_single_sine(preset, speed):
     rng = np.random.default_rng(9)
     B = 70                                     # two groups
     values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, B) for n in names}
-    ra = single_sine_batched(VariantBatch(v, values), speed)
+    ra, ra_r = single_sine_batched(VariantBatch(v, values), speed)
     for i in (0, 1, 63, 64, 69):
-        ref = single_sine(_variant(v, values, i), speed).rearward_amplification
-        assert ra[i] == pytest.approx(ref, rel=1e-12), i
+        s = single_sine(_variant(v, values, i), speed)
+        assert ra[i] == pytest.approx(s.rearward_amplification, rel=1e-12), i
+        r = s.response.peaks_abs(["r1", f"r{v.n_units}"])          # the yaw rates' peaks, one variant
+        assert ra_r[i] == pytest.approx(r[1] / r[0], rel=1e-12), i
 
 
 @pytest.mark.parametrize("preset,speed", [("aucnat", 24.0), ("tractor_semitrailer", 30.0), ("legal_max", 20.0)])

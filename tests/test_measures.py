@@ -238,7 +238,9 @@ SPEC_KEYS = {"speed_mps", "least_damping_ratio", "least_damped_frequency_hz", "c
              # SPEC 17: the roll measures (null, with the missing key named, without roll data)
              "srt_g", "srt_rrcu_g", "srt_min_g", "roll_least_damping_ratio", "roll_critical_speed_kph",
              "ra_single_sine_roll", "ltr_single_sine", "ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change",
-             "rltr_lane_change", "roll_gain_deg_per_g"}
+             "rltr_lane_change", "roll_gain_deg_per_g",
+             # the assessment's measures (docs/measures.md): yaw-rate RA, tracking on a straight path
+             "ra_yaw_rate_single_sine", "tasp_m"}
 
 
 @pytest.mark.parametrize("source", [["--preset", "aucnat"]] + [["--vehicle", str(EXAMPLES / f"{n}.toml")]

@@ -123,6 +123,15 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML: position, conicity_N, "
                                                          "ply_steer_N, serial_side[, moments]): their axle P and T")
 
+    def conditions(sp: argparse.ArgumentParser) -> None:
+        from ..measures.registry import CONDITIONS
+        for c in CONDITIONS.values():
+            if c.key in ("speed_kph", "crossfall_percent"):
+                continue
+            sp.add_argument(c.option, dest=c.key, type=_ranged(c.range, unit=c.unit, what=c.label), metavar="X",
+                            help=c.definition.replace("%", "%%") + f" [{c.unit}], in "
+                                 f"{_help_range(c.range, unit=c.unit)}; default {c.default:g}")
+
     sim = sub.add_parser("simulate", help="exact response from rest to a steer input and residual sources, "
                                           "streamed as CSV (or JSON), SI units")
     common(sim, False)
@@ -146,6 +155,7 @@ def build_parser() -> argparse.ArgumentParser:
     tires(mea)
     load(mea, False, convention=False)
     residuals(mea)
+    conditions(mea)
     mea.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
     mea.add_argument("--json", action="store_true", help="machine-readable output")
     fmu = sub.add_parser("fmu", help="FMUs of the vehicle (FMI 2.0 or 3.0; native: Co-Simulation and Model Exchange)")

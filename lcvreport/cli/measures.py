@@ -24,10 +24,16 @@ def _cmd_measures(args, out: _Out) -> int:
             criteria = load_criteria(args.criteria)
         except CriteriaError as exc:
             raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
+    from ..measures.registry import CONDITIONS
+    conditions = {k: getattr(args, k) for k in CONDITIONS if k not in ("speed_kph", "ra_frequency_hz",
+                                                                       "crossfall_percent")
+                  and getattr(args, k, None) is not None}
+    f_hz = args.ra_frequency_hz if args.ra_frequency_hz is not None else CONDITIONS["ra_frequency_hz"].default
     docs, sets = [], []
     for u in speeds:
         try:
-            m = measure_set(v, u, args.tire_scale, units, sources=sources if sources else None)
+            m = measure_set(v, u, args.tire_scale, units, f_hz=f_hz, sources=sources if sources else None,
+                            conditions=conditions)
         except ValueError as exc:
             if "static_load_N" in str(exc):
                 raise UsageError(f"argument --load: {exc}") from None

@@ -318,18 +318,35 @@ def _golden(batch: VariantBatch, speed_mps, tire_scale, idx, a, c) -> np.ndarray
 
 
 def single_sine_batched(batch: VariantBatch, speed_mps: float, f_hz: float | None = None,
-                        tire_scale: float = 1.0) -> np.ndarray:
-    """RA of the single sine [-] of every variant: max|a_N| / max|a_1| on the continuous exact
-    response (:func:`lcvreport.measures.amplification.single_sine`: ``delta0 sin(2 pi f t)`` for one
+                        tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(RA, yaw-rate RA) of the single sine [-] of every variant: max|a_N| / max|a_1| and
+    max|r_N| / max|r_1| on the continuous exact response
+    (:func:`lcvreport.measures.amplification.single_sine`: ``delta0 sin(2 pi f t)`` for one
     period, then the tail)."""
+    from ..analysis.batch import RESPONSE_GROUP
     from ..analysis.frequency import RA_FREQUENCY_HZ, _freq
     from ..manoeuvres.steer import sine
     f = float(_freq(RA_FREQUENCY_HZ if f_hz is None else f_hz))
     steer = sine(SINGLE_SINE_DELTA0_RAD, f)
     t_end = round((1.0 / f + SINGLE_SINE_TAIL_S) / SINGLE_SINE_STEP_S) * SINGLE_SINE_STEP_S
-    peaks = batch.ay_peaks(speed_mps, steer, t_end, SINGLE_SINE_STEP_S, [0, batch.vehicle.n_units - 1],
-                          tire_scale)
-    return peaks[:, 1] / peaks[:, 0]
+    last = batch.vehicle.n_units - 1
+    ay_rows = batch.ay_rows(speed_mps, [0, last])
+    r_map = linear_model(batch.vehicle, batch.model).yaw_rate_map()[[0, last]]
+
+    def signals(Mz, d_row, ctx):
+        n = ctx[3]
+        C = np.zeros((Mz.shape[0], 4, Mz.shape[-1]))
+        C[:, :2] = ay_rows(Mz, d_row, ctx)                    # a_1, a_N
+        C[:, 2:, :n] = r_map                                  # r_1, r_N
+        return C
+    peaks = []
+    for g in range(0, batch.size, RESPONSE_GROUP):
+        rows = np.arange(g, min(batch.size, g + RESPONSE_GROUP))
+        hi, lo = batch.extremes(speed_mps, steer, t_end, SINGLE_SINE_STEP_S, signals, tire_scale, rows,
+                                positions=False)
+        peaks.append(np.maximum(np.abs(hi), np.abs(lo)))
+    peaks = np.concatenate(peaks)
+    return peaks[:, 1] / peaks[:, 0], peaks[:, 3] / peaks[:, 2]
 
 
 def frequency_response_family(case: MeasureCase) -> tuple[dict, dict]:
@@ -347,7 +364,8 @@ def ra_frequency_batched(batch: VariantBatch, speed_mps: float, f_hz: float, tir
 def single_sine_family(case: MeasureCase) -> tuple[dict, dict]:
     """The registry's ``single_sine`` family of one case."""
     ss = single_sine(case.vehicle, case.speed_mps, case.f_hz, tire_scale=case.tire_scale)
-    return {"ra_single_sine": ss.rearward_amplification}, {}
+    r = ss.response.peaks_abs([f"r{i + 1}" for i in (0, case.vehicle.n_units - 1)])
+    return {"ra_single_sine": ss.rearward_amplification, "ra_yaw_rate_single_sine": float(r[1] / r[0])}, {}
 
 
 def ra_peak_family(case: MeasureCase) -> tuple[dict, dict]:

@@ -59,12 +59,16 @@ from .registry import MeasureCase
 
 
 @functools.lru_cache(maxsize=64)
-def low_speed_measures(vehicle: Vehicle) -> tuple[dict, dict]:
-    """The low-speed turn's measures of ``vehicle`` (docs/low_speed_turn.md) (independent of speed and tire scale: cached
-    per vehicle) and, for each that is null, why: (values, reasons)."""
+def low_speed_measures(vehicle: Vehicle, radius_m: float | None = None, angle_deg: float | None = None
+                       ) -> tuple[dict, dict]:
+    """The low-speed turn's measures of ``vehicle`` (docs/low_speed_turn.md) in the turn of
+    ``radius_m`` [m] and ``angle_deg`` [deg] (default :data:`RADIUS_M`, :data:`ANGLE_DEG`;
+    independent of speed and tire scale: cached per vehicle and turn) and, for each that is
+    null, why: (values, reasons)."""
     from ..model.body import TurnError
     try:
-        t = low_speed_turn(vehicle)
+        t = low_speed_turn(vehicle, RADIUS_M if radius_m is None else float(radius_m),
+                           ANGLE_DEG if angle_deg is None else float(angle_deg))
     except TurnError as exc:
         return {}, {k: f"undefined: {exc}" for k in LOW_SPEED_KEYS}
     values = {"lssp_m": t.lssp_m, "low_speed_offtracking_m": t.low_speed_offtracking_m,
@@ -429,4 +433,4 @@ def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: floa
 
 def low_speed_family(case: MeasureCase) -> tuple[dict, dict]:
     """The registry's ``low_speed_turn`` family of one case (the speed plays no part)."""
-    return low_speed_measures(case.vehicle)
+    return low_speed_measures(case.vehicle, case.condition("turn_radius_m"), case.condition("turn_angle_deg"))

@@ -29,7 +29,7 @@ from ..model.vehicle import Vehicle
 from ..model.yaw_plane.loads import load_vector, one_percent_rule
 from ..units import mps_to_kph
 from ..util.threads import one_blas_thread
-from .registry import FAMILIES, MEASURES, MeasureCase
+from .registry import CONDITIONS, FAMILIES, MEASURES, MeasureCase
 
 
 @dataclass(frozen=True)
@@ -51,6 +51,8 @@ class MeasureSet:
     #: measure key -> why it is null (e.g. no steered axle: no steer input to respond to)
     undefined: dict = field(default_factory=dict)
     trim: Trim | None = None
+    #: the conditions given other than the speed and f_hz (the rest at their defaults)
+    conditions: dict = field(default_factory=dict)
 
     def __getattr__(self, name: str):
         if not name.startswith("_") and name in MEASURES:
@@ -124,8 +126,11 @@ class MeasureSet:
                                  "json_key": "trim"})
             else:
                 note = m.definition if value is not None else self.reason(key)
-                if key in ("ra_frequency", "ra_single_sine"):
+                if key in ("ra_frequency", "ra_single_sine", "ra_yaw_rate_single_sine"):
                     note = note.replace("0.4 Hz", f)
+                given = [f"{k} = {self.conditions[k]:g}" for k in m.conditions if k in self.conditions]
+                if given and value is not None:
+                    note = f"{note}; here {', '.join(given)}"
                 rows.append({"measure": m.label.replace("0.4 Hz", f), "value": "none" if value is None else value,
                              "unit": m.unit, "note": note, "json_key": key})
         return rows
@@ -147,7 +152,7 @@ def residual_force(vehicle: Vehicle, load_units=None, sources=None, tire_scale: 
 
 @one_blas_thread
 def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, load_units=None,
-                f_hz: float = RA_FREQUENCY_HZ, sources=None) -> MeasureSet:
+                f_hz: float = RA_FREQUENCY_HZ, sources=None, conditions: dict | None = None) -> MeasureSet:
     """Every measure of the registry (``docs/measures.md``) of ``vehicle`` at ``speed_mps`` [m/s]:
     each family of :data:`lcvreport.measures.registry.FAMILIES` in turn.
 
@@ -163,6 +168,12 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     sources : lcvreport.model.yaw_plane.loads.ResidualSources, optional
         Further residual sources for the trim (per-axle P and T, misalignment, crossfall);
         with ``load_units`` the 1 % rule adds to them.
+    conditions : dict, optional
+        The manoeuvres' conditions by :data:`~lcvreport.measures.registry.CONDITIONS` key (the
+        lane change's ``lane_change_ay_g`` and ``lane_change_frequency_hz``, the steady turn's
+        ``steady_turn_radius_m``, the low-speed turn's ``turn_radius_m`` and ``turn_angle_deg``);
+        each one not given at its default.  (The speed is ``speed_mps``, the RA frequency
+        ``f_hz``, the crossfall a residual source.)
 
     Examples
     --------
@@ -174,8 +185,9 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     True
     """
     units = tuple(load_units) if load_units else ()
+    conditions = check_conditions(conditions)
     case = MeasureCase(vehicle, float(speed_mps), float(tire_scale), float(f_hz),
-                       residual_force(vehicle, units, sources, tire_scale))
+                       residual_force(vehicle, units, sources, tire_scale), conditions=conditions)
     values, undefined = {}, {}
     # each family keeps only its numbers: a manoeuvre's response (up to a megabyte of samples) is
     # freed before the next one is computed (a smaller heap, which malloc does not hand back)
@@ -186,15 +198,18 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
             undefined.update(why)
     return MeasureSet(vehicle=vehicle, speed_mps=float(speed_mps), tire_scale=float(tire_scale), f_hz=float(f_hz),
                       load_units=units, sources=sources, values=values, undefined=undefined,
-                      trim=case.shared.get("trim"))
+                      trim=case.shared.get("trim"), conditions=conditions)
 
 
 @one_blas_thread
 def measure_values(vehicle: Vehicle, speed_mps: float, keys, tire_scale: float = 1.0, load_units=None,
-                   f_hz: float = RA_FREQUENCY_HZ, sources=None) -> dict:
+                   f_hz: float = RA_FREQUENCY_HZ, sources=None, conditions: dict | None = None,
+                   reasons: dict | None = None) -> dict:
     """The values of the registry keys ``keys`` only, as :func:`measure_set` gives them (None
     where undefined), computing just their families (and those they take a result from: the yaw
-    damping compares with the least damping ratio) -- what a study computes case by case.
+    damping compares with the least damping ratio) -- what a study computes case by case and
+    an assessment per set of conditions.  ``conditions`` as :func:`measure_set`'s; ``reasons``,
+    a dict, receives why each null is null.
 
     Examples
     --------
@@ -205,15 +220,37 @@ def measure_values(vehicle: Vehicle, speed_mps: float, keys, tire_scale: float =
     """
     units = tuple(load_units) if load_units else ()
     case = MeasureCase(vehicle, float(speed_mps), float(tire_scale), float(f_hz),
-                       residual_force(vehicle, units, sources, tire_scale))
+                       residual_force(vehicle, units, sources, tire_scale), conditions=check_conditions(conditions))
     needed = {MEASURES[k].family for k in keys if MEASURES[k].family}
     if "yaw_damping" in needed:
         needed.add("least_damping")
-    values = {}
+    values, why = {}, {}
     for name, family in FAMILIES.items():
         if name in needed and family.applies(case):
-            values.update(family.compute(case)[0])
+            v, w = family.compute(case)
+            values.update(v)
+            why.update(w)
+    if reasons is not None:
+        probe = MeasureSet(vehicle=vehicle, speed_mps=float(speed_mps), values=values, undefined=why)
+        reasons.update({k: probe.reason(k) for k in keys if values.get(k) is None})
     return {k: values.get(k) for k in keys}
+
+
+def check_conditions(conditions: dict | None) -> dict:
+    """``conditions`` checked against the registry (known keys other than the speed, the RA
+    frequency and the crossfall, which have their own arguments) and the ranges table.
+
+    Raises
+    ------
+    KeyError, lcvreport.ranges.RangeError
+    """
+    out = {}
+    for key, value in (conditions or {}).items():
+        if key not in CONDITIONS or key in ("speed_kph", "ra_frequency_hz", "crossfall_percent"):
+            valid = [k for k in CONDITIONS if k not in ("speed_kph", "ra_frequency_hz", "crossfall_percent")]
+            raise KeyError(f"unknown condition {key!r}; valid: {', '.join(valid)}")
+        out[key] = CONDITIONS[key].check(value)
+    return out
 
 
 @one_blas_thread

@@ -197,20 +197,23 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
     return SteadyTurn(float(hsso), delta, float(radius_m), x, paths, beta, d)
 
 
-def lane_change_batched(batch: VariantBatch, speed_mps: float,
-                        tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0,
+                        lane_change_ay_g: float | None = None,
+                        lane_change_frequency_hz: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(HSTO [m], the lane change's RA [-]) of every variant, as
     :func:`lcvreport.measures.offtracking.lane_change_measures` (the path-following lane
     change through each variant's inverse system): the last unit's rearmost axle's largest
     overshoot beyond the steered axle's final offset (0 if none), and max|a_N| / max|a_s|.
     NaN where the inverse system is unstable or does not exist, or the steer leaves
-    [-1, 1] rad (measure_set's null)."""
+    [-1, 1] rad (measure_set's null).  ``lane_change_ay_g`` [g] and ``lane_change_frequency_hz``
+    [Hz]: A0 and F (default :data:`LANE_CHANGE`)."""
     from ..analysis.exact import steered_point
     from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
     from ..model.yaw_plane.outputs import point_lateral_map
     v = batch.vehicle
     B, nu, n = batch.size, v.n_units, linear_model(v).n_states
-    accel_g, f_hz = LANE_CHANGE
+    accel_g = LANE_CHANGE[0] if lane_change_ay_g is None else float(lane_change_ay_g)
+    f_hz = LANE_CHANGE[1] if lane_change_frequency_hz is None else float(lane_change_frequency_hz)
     steer = lane_change(accel_g * G_MPS2, f_hz)
     t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
     offset = lane_change_offset_m(steer)
@@ -251,11 +254,12 @@ def lane_change_batched(batch: VariantBatch, speed_mps: float,
     return hsto, ra
 
 
-def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0, radius_m: float | None = None
-                        ) -> tuple[np.ndarray, np.ndarray]:
+def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0,
+                        steady_turn_radius_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(hsso_m, steer [rad]) of every variant in the steady turn of
-    :func:`lcvreport.measures.offtracking.steady_turn` (tractor yaw rate u/R)."""
-    R = HSSO_RADIUS_M if radius_m is None else float(radius_m)
+    :func:`lcvreport.measures.offtracking.steady_turn` (tractor yaw rate u/R, R =
+    ``steady_turn_radius_m``, default :data:`HSSO_RADIUS_M`)."""
+    R = HSSO_RADIUS_M if steady_turn_radius_m is None else float(steady_turn_radius_m)
     u = float(speed_mps)
     omega = u / R
     v = batch.vehicle
@@ -273,7 +277,8 @@ def lane_change_family(case: MeasureCase) -> tuple[dict, dict]:
     manoeuvre cannot be followed)."""
     keys = ("hsto_m", "ra_lane_change")
     try:
-        lc = lane_change_measures(case.vehicle, case.speed_mps, case.tire_scale)
+        lc = lane_change_measures(case.vehicle, case.speed_mps, case.tire_scale,
+                                  case.condition("lane_change_ay_g"), case.condition("lane_change_frequency_hz"))
     except ManoeuvreError as exc:
         return dict.fromkeys(keys), dict.fromkeys(keys, f"undefined: {exc}")
     return {"hsto_m": lc.hsto_m, "ra_lane_change": lc.ra_lane_change}, {}
@@ -281,8 +286,81 @@ def lane_change_family(case: MeasureCase) -> tuple[dict, dict]:
 
 def steady_turn_family(case: MeasureCase) -> tuple[dict, dict]:
     """The registry's ``steady_turn`` family of one case."""
-    turn = steady_turn(case.vehicle, case.speed_mps, case.tire_scale)
+    turn = steady_turn(case.vehicle, case.speed_mps, case.tire_scale, case.condition("steady_turn_radius_m"))
     return {"hsso_m": turn.hsso_m, "steady_turn_delta_rad": turn.delta_rad}, {}
+
+
+@dataclass(frozen=True)
+class StraightPath:
+    """Tracking ability on a straight path (docs/measures.md#tracking-ability-on-a-straight-path):
+    the combination trimmed straight against its residual sources, every body's outline at its
+    steady offset and heading.
+
+    Attributes
+    ----------
+    tasp_m : float
+        Width of the band the bodies sweep, across the direction of travel [m].
+    left_m, right_m : numpy.ndarray, shape (N,)
+        Every unit's outermost body point to the left (+y) and right of the steered axle's
+        path [m] (the band is ``max(left_m) - min(right_m)``).
+    trim : Trim
+    """
+
+    tasp_m: float
+    left_m: np.ndarray
+    right_m: np.ndarray
+    trim: object
+
+
+def straight_path(vehicle: Vehicle, speed_mps: float, F=None, tire_scale: float = 1.0) -> StraightPath:
+    """The straight-path band of ``vehicle`` at ``speed_mps`` [m/s] under the generalized force
+    ``F`` [SI] (None: no residual source; the band is then the widest body): the trim
+    (:func:`lcvreport.analysis.steady.trim`) puts every unit at a constant articulation and
+    crab; a body point at signed x on unit k lies ``Y_k(x) - (X_k(x) - X_s) v_1/u`` from the
+    steered axle's path (first order in the angles), each side ``body_width_m / 2`` beyond it.
+
+    Raises
+    ------
+    lcvreport.model.body.TurnError
+        A unit without ``body_front_m``, ``body_rear_m`` or ``body_width_m``.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> round(straight_path(load_preset("aucnat"), 24.4444).tasp_m, 4)       # no source: the widest body
+    2.5908
+    """
+    from ..analysis.steady import reference_points
+    from ..model.body import _need_bodies
+    from ..model.yaw_plane.outputs import point_longitudinal, point_lateral_map
+    _need_bodies(vehicle)
+    n = linear_model(vehicle).n_states
+    tr = trim(vehicle, speed_mps, np.zeros(n) if F is None else np.asarray(F, dtype=float), tire_scale)
+    check_trim(tr)
+    x = tr.state
+    nu = vehicle.n_units
+    Theta = np.cumsum(x[nu + 1:])
+    (uq, xq), _ = reference_points(vehicle)
+    Xq = point_longitudinal(vehicle, uq, xq)
+    yq = float(point_lateral_map(vehicle, uq, xq)[2:] @ Theta)
+    crab = x[0] / float(speed_mps)
+    left, right = np.empty(nu), np.empty(nu)
+    for k, unit in enumerate(vehicle.units):
+        ys = [float(point_lateral_map(vehicle, k, xb)[2:] @ Theta) - yq - (point_longitudinal(vehicle, k, xb) - Xq) * crab
+              for xb in (unit.body_front_m, unit.body_rear_m)]
+        left[k], right[k] = max(ys) + unit.body_width_m / 2, min(ys) - unit.body_width_m / 2
+    return StraightPath(float(left.max() - right.min()), left, right, tr)
+
+
+def straight_path_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``straight_path`` family of one case (null, with the key missing, where a
+    unit has no body dimensions)."""
+    from ..model.body import TurnError
+    try:
+        sp = straight_path(case.vehicle, case.speed_mps, case.F, case.tire_scale)
+    except TurnError as exc:
+        return {"tasp_m": None}, {"tasp_m": f"undefined: {str(exc).replace('the low-speed turn', 'the straight path')}"}
+    return {"tasp_m": sp.tasp_m}, {}
 
 
 def trim_family(case: MeasureCase) -> tuple[dict, dict]:

@@ -67,6 +67,18 @@ class MeasureCase:
     f_hz: float
     F: Any = None
     shared: dict = field(default_factory=dict)
+    #: the conditions other than the speed (:data:`CONDITIONS` keys); a key not given takes
+    #: its default (``ra_frequency_hz`` is ``f_hz``)
+    conditions: dict = field(default_factory=dict)
+
+    def condition(self, key: str) -> float:
+        """The value of the condition ``key`` in its unit (:data:`CONDITIONS`)."""
+        if key == "ra_frequency_hz":
+            return self.f_hz
+        if key == "speed_kph":
+            return self.speed_mps * 3.6
+        value = self.conditions.get(key)
+        return CONDITIONS[key].default if value is None else float(value)
 
 
 def _resolve(ref: str):
@@ -86,6 +98,8 @@ class Family:
     batched: str | None = None
     model: str = "yaw_plane"
     needs: str = ""
+    #: the conditions it depends on (:data:`CONDITIONS` keys, ``speed_kph`` first if any)
+    conditions: tuple = ()
 
     @property
     def keys(self) -> tuple[str, ...]:
@@ -114,6 +128,7 @@ class Family:
         fn = _resolve(self.batched)
         names = inspect.signature(fn).parameters
         kwargs = {k: getattr(case, k) for k in ("speed_mps", "tire_scale", "f_hz", "F") if k in names}
+        kwargs.update({k: case.condition(k) for k in self.conditions if k in names})
         out = fn(batch, **kwargs)
         return out if isinstance(out, tuple) else (out,)
 
@@ -141,6 +156,11 @@ class Measure:
         return FAMILIES[self.family].needs if self.family else ""
 
     @property
+    def conditions(self) -> tuple:
+        """The conditions it is computed under (its family's; the speed's key first)."""
+        return FAMILIES[self.family].conditions if self.family else ()
+
+    @property
     def batched(self) -> str | None:
         """The batched family that gives it over variants, or None."""
         return self.family if self.family and self.key in FAMILIES[self.family].batched_keys else None
@@ -151,18 +171,45 @@ class Measure:
         return f"docs/measures.md#{self.doc}"
 
 
-def _load(text: str) -> tuple[dict, dict]:
-    """(FAMILIES, MEASURES) from the registry's data file."""
+@dataclass(frozen=True)
+class Condition:
+    """What a measure is computed under: ``key`` (with its unit, as a scheme file and ``lcv
+    measures`` write it), ``label``, ``unit``, the ``range`` of :data:`lcvreport.ranges.RANGES`
+    bounding it (in ``unit``, except the speed's, in m/s), its ``default`` (None: must be given)."""
+
+    key: str
+    label: str
+    unit: str
+    range: str
+    definition: str
+    default: float | None = None
+
+    @property
+    def option(self) -> str:
+        """The ``lcv measures`` option that sets it."""
+        return "--" + self.key.replace("_", "-")
+
+    def check(self, value, name: str | None = None) -> float:
+        """``value`` as a float, or :class:`lcvreport.ranges.RangeError` naming ``name``."""
+        from ..ranges import RANGES
+        factor = 3.6 if self.key == "speed_kph" else 1.0
+        return RANGES[self.range].check(value, name or self.key, factor=factor, unit=self.unit)
+
+
+def _load(text: str) -> tuple[dict, dict, dict]:
+    """(CONDITIONS, FAMILIES, MEASURES) from the registry's data file."""
     import tomllib
     doc = tomllib.loads(text)
-    families = {name: Family(name, **entry) for name, entry in doc["families"].items()}
+    conditions = {key: Condition(key, **entry) for key, entry in doc["conditions"].items()}
+    families = {name: Family(name, **{k: tuple(v) if k == "conditions" else v for k, v in entry.items()})
+                for name, entry in doc["families"].items()}
     measures = {m["key"]: Measure(**m) for m in doc["measures"]}
-    return families, measures
+    return conditions, families, measures
 
 
-#: the families, in the order measure_set computes them, and the measures, in the order of
-#: ``lcv measures --json``: the data file ``lcvreport/data/measures.toml``
-FAMILIES, MEASURES = _load(resources.files(__package__.partition(".")[0]).joinpath(
+#: the conditions, the families (in the order measure_set computes them) and the measures (in
+#: the order of ``lcv measures --json``): the data file ``lcvreport/data/measures.toml``
+CONDITIONS, FAMILIES, MEASURES = _load(resources.files(__package__.partition(".")[0]).joinpath(
     "data", "measures.toml").read_text(encoding="utf-8"))
 
 #: the keys a criteria file or a study may name: every scalar measure (not the speed, a condition)

@@ -110,8 +110,10 @@ def roll_summary(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) ->
                        values["roll_critical_speed_kph"], reasons)
 
 
-def _dynamic(vehicle: Vehicle, u: float, s: float) -> tuple[dict, dict]:
-    """The roll family's values and reasons (roll data present)."""
+def _dynamic(vehicle: Vehicle, u: float, s: float, f_hz: float = LANE_CHANGE[1],
+             lane_change: tuple[float, float] = LANE_CHANGE) -> tuple[dict, dict]:
+    """The roll family's values and reasons (roll data present): the single sine at ``f_hz``
+    [Hz], the lane change of ``lane_change`` (A0 [g], F [Hz])."""
     values, reasons = dict.fromkeys(ROLL_KEYS), {}
     zeta, _f = least_damping(vehicle, u, s, model=MODEL)
     values["roll_least_damping_ratio"] = zeta
@@ -126,10 +128,10 @@ def _dynamic(vehicle: Vehicle, u: float, s: float) -> tuple[dict, dict]:
                   "rltr_lane_change", "roll_gain_deg_per_g"):
             reasons[k] = NO_STEER
         return values, reasons
-    values["ra_single_sine_roll"], values["ltr_single_sine"] = ltr_single_sine(vehicle, u, s)
+    values["ra_single_sine_roll"], values["ltr_single_sine"] = ltr_single_sine(vehicle, u, s, f_hz)
     groups = len(linear_model(vehicle, MODEL).roll.groups)
     try:
-        lc = lane_change_measures(vehicle, u, s, model=MODEL)
+        lc = lane_change_measures(vehicle, u, s, *lane_change, model=MODEL)
     except ManoeuvreError as exc:
         for k in ("ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change", "rltr_lane_change"):
             reasons[k] = f"undefined: {exc}"
@@ -156,7 +158,8 @@ def roll_family(case: MeasureCase) -> tuple[dict, dict]:
     missing = _no_roll(ROLL_KEYS, case.vehicle)
     if missing is not None:
         return missing
-    return _dynamic(case.vehicle, case.speed_mps, case.tire_scale)
+    return _dynamic(case.vehicle, case.speed_mps, case.tire_scale, case.f_hz,
+                    (case.condition("lane_change_ay_g"), case.condition("lane_change_frequency_hz")))
 
 
 def rollover_family(case: MeasureCase) -> tuple[dict, dict]:
