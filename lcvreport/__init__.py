@@ -68,6 +68,8 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``roll``             the roll measures: LTR, roll gains, the yaw-roll model's RA, HSTO, damping
     ``measure_set``      every measure of a vehicle at a speed (MeasureSet)
     ``criteria``         the user's limits and the verdicts
+    ``scheme``           scheme files: levels, and per measure its conditions and limits per level
+    ``assess``           every measure of a scheme at its conditions, verdicts per level, the level reached
 ``tracking/``            **straight-line tracking** over a tire population:
     ``tires``            tire slots, per-axle residuals, sensitivities, the mounted-tires file
     ``statistics``       fleet statistics of the trimmed offtracking
@@ -119,6 +121,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``tracking``         tracking place, tracking stats
     ``turn``             the low-speed turn
     ``roll``             the static rollover threshold, roll gains, LTR
+    ``assess``           an assessment against a scheme file: the verdict table, text or JSON
     ``artifacts``        fmu, report, study
 ``_entry``               the console script (one BLAS thread first)
 

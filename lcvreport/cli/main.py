@@ -35,6 +35,7 @@ from typing import Sequence
 from ..ranges import RangeError
 from ..units import MPS_PER_KPH, MPS_PER_MPH
 from .artifacts import _cmd_fmu, _cmd_report, _cmd_study
+from .assess import _cmd_assess
 from .measures import _cmd_measures
 from .model import _cmd_eig, _cmd_matrices, _cmd_presets, _cmd_steady
 from .options import UsageError, _help_range, _line, _ranged
@@ -246,6 +247,22 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--criteria", metavar="FILE", help="with --report: limits to judge the cases by (TOML)")
     st.add_argument("--no-pdf", action="store_true", help="with --report: HTML only")
     st.add_argument("--json", action="store_true", help="machine-readable summary")
+    ass = sub.add_parser("assess", help="a performance-based standards assessment: every measure of a scheme file "
+                                        "at its own conditions, judged per level (docs/assessment.md)")
+    source(ass)
+    ass.add_argument("--scheme", required=True, metavar="FILE",
+                     help="the scheme file (TOML): levels, and per measure its conditions and limits per level, "
+                          "each with its source (examples/schemes/)")
+    tires(ass)
+    load(ass, False, convention=False)
+    ass.add_argument("--residual", action="append", default=[], metavar="AXLE=P,T",
+                     help="residual force P [N] (+y) and moment T [N*m] (+z) on an axle, a source of the trim and "
+                          "the straight path; repeatable (the crossfall is the scheme's crossfall_percent)")
+    ass.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
+                     help=f"thrust angle of an axle [rad], in {_help_range('misalignment')}; repeatable or "
+                          f"comma-separated")
+    ass.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML): their axle P and T")
+    ass.add_argument("--json", action="store_true", help="machine-readable output (docs/assessment.md)")
     rol = sub.add_parser("roll", help="roll: static rollover threshold per roll-coupled group (lift-off axle by "
                                       "axle), roll gains, load transfer ratios, roll modes (docs/roll.md)")
     common(rol, None)
@@ -257,7 +274,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 COMMANDS = {"presets": _cmd_presets, "eig": _cmd_eig, "matrices": _cmd_matrices, "steady": _cmd_steady,
             "simulate": _cmd_simulate, "measures": _cmd_measures, "fmu": _cmd_fmu, "report": _cmd_report,
-            "tracking": _cmd_tracking, "turn": _cmd_turn, "study": _cmd_study, "roll": _cmd_roll}
+            "tracking": _cmd_tracking, "turn": _cmd_turn, "study": _cmd_study, "roll": _cmd_roll,
+            "assess": _cmd_assess}
 
 
 def run(argv: Sequence[str] | None = None, out=None) -> int:

@@ -145,6 +145,8 @@ class Measure:
     family: str | None = None
     limit: str | None = None
     shape: str = "scalar"
+    #: the conditions it depends on, where fewer than its family's (None: the family's)
+    own_conditions: tuple | None = None
 
     @property
     def model(self) -> str:
@@ -157,7 +159,10 @@ class Measure:
 
     @property
     def conditions(self) -> tuple:
-        """The conditions it is computed under (its family's; the speed's key first)."""
+        """The conditions it depends on (its own where the registry gives them, else its family's;
+        the speed's key first)."""
+        if self.own_conditions is not None:
+            return self.own_conditions
         return FAMILIES[self.family].conditions if self.family else ()
 
     @property
@@ -183,6 +188,8 @@ class Condition:
     range: str
     definition: str
     default: float | None = None
+    #: the short name of a verdict table ("A0 0.15 g"; empty: the value and unit alone)
+    short: str = ""
 
     @property
     def option(self) -> str:
@@ -203,7 +210,9 @@ def _load(text: str) -> tuple[dict, dict, dict]:
     conditions = {key: Condition(key, **entry) for key, entry in doc["conditions"].items()}
     families = {name: Family(name, **{k: tuple(v) if k == "conditions" else v for k, v in entry.items()})
                 for name, entry in doc["families"].items()}
-    measures = {m["key"]: Measure(**m) for m in doc["measures"]}
+    measures = {m["key"]: Measure(**{k: v for k, v in m.items() if k != "conditions"},
+                                  own_conditions=tuple(m["conditions"]) if "conditions" in m else None)
+                for m in doc["measures"]}
     return conditions, families, measures
 
 

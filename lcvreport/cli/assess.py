@@ -1,0 +1,62 @@
+"""``lcv assess``: every measure of a scheme file at its own conditions, judged per level; the
+verdict table, the level each measure reaches and the vehicle's (docs/assessment.md)."""
+from __future__ import annotations
+
+from .options import UsageError, _line, _load_units, _sources, _vehicle
+from .output import _Out
+
+
+def load_scheme_option(path: str):
+    """The scheme of ``--scheme`` (one line naming the key, exit 2, before anything is computed)."""
+    from ..measures.scheme import SchemeError, load_scheme
+    try:
+        return load_scheme(path)
+    except SchemeError as exc:
+        raise UsageError(f"argument --scheme {path}: {exc}") from None
+
+
+def assessment_of(args):
+    """(vehicle, scheme, assessment) of the options."""
+    from ..measures.assess import assess
+    v = _vehicle(args)
+    scheme = load_scheme_option(args.scheme)
+    units = _load_units(args, v) if args.load is not None else None
+    sources = _sources(args, v)
+    return v, scheme, assess(v, scheme, args.tire_scale, units, sources if sources else None)
+
+
+def _cmd_assess(args, out: _Out) -> int:
+    v, scheme, a = assessment_of(args)
+    if args.json:
+        out.json(a.to_dict())
+        return 0
+    for line in verdict_lines(a):
+        out.line(line)
+    return 0
+
+
+def verdict_lines(a) -> list[str]:
+    """The verdict table as text lines: a header naming the scheme and its status, one line per
+    measure (conditions, value, the verdict at every level, the level reached), the vehicle's
+    level, and the reason of every measure that does not reach the first level."""
+    s = a.scheme
+    status = {"template": " -- a TEMPLATE: its numbers are placeholders, not a standard",
+              "draft": " -- a DRAFT"}.get(s.status, "")
+    lines = [f"{a.vehicle.name} assessed against {s.name}{status}",
+             f"  levels, most demanding first: {', '.join(s.levels)}; tire scale {a.tire_scale:g}"]
+    width = max(8, *(len(level) for level in s.levels))
+    head = f"  {'measure':<28} {'conditions':<32} {'value':>10} {'unit':<5}"
+    lines.append(head + "".join(f" {level:>{width}}" for level in s.levels) + "  reached")
+    word = {"pass": "pass", "fail": "FAIL", "not computed": "n/c"}
+    for m in a.measures:
+        value = "none" if m.value is None else f"{m.value:.4g}"
+        row = f"  {m.key:<28} {m.conditions_text():<32} {value:>10} {m.unit:<5}"
+        lines.append(row + "".join(f" {word[m.verdicts[level]]:>{width}}" for level in s.levels)
+                     + f"  {m.level_reached or 'none'}")
+    lines.append(f"  level reached by the vehicle: {a.level_reached or 'none'}"
+                 + (f" ({_line(a.reason)})" if a.reason else ""))
+    for m in a.measures:
+        if m.reason:
+            lines.append(f"  {m.key}: {_line(m.reason)}")
+    lines.append("  (n/c: not computed, the reason above; limits and sources: lcv assess --json, or the report)")
+    return lines
