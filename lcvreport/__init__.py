@@ -44,6 +44,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``tracking``         offtracking histogram, axle sensitivities, mounting study
     ``study``            scatter and pass rates of a study
     ``roll``             the a_y - phi curve of the static rollover threshold
+    ``assessment``       an assessment's evidence with every level's limit drawn on it
     ``charts``           grouped bars and fitted curves
 ``analysis/``            **linear analysis** (numpy, scipy):
     ``modes``            eigenvalues, damping, mode shapes
@@ -70,6 +71,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``criteria``         the user's limits and the verdicts
     ``scheme``           scheme files: levels, and per measure its conditions and limits per level
     ``assess``           every measure of a scheme at its conditions, verdicts per level, the level reached
+    ``evidence``         what each measure of an assessment was read from, recomputed at its conditions
 ``tracking/``            **straight-line tracking** over a tire population:
     ``tires``            tire slots, per-axle residuals, sensitivities, the mounted-tires file
     ``statistics``       fleet statistics of the trimmed offtracking

@@ -26,13 +26,53 @@ def assessment_of(args):
 
 
 def _cmd_assess(args, out: _Out) -> int:
+    if args.out is not None:
+        from ..report.publish import OutputFolderError, check_output_folder
+        try:
+            check_output_folder(args.out)          # before anything is computed
+        except OutputFolderError as exc:
+            raise UsageError(f"argument {exc}") from None
     v, scheme, a = assessment_of(args)
+    if args.out is not None:
+        _write_report(args, a)
     if args.json:
         out.json(a.to_dict())
         return 0
     for line in verdict_lines(a):
         out.line(line)
     return 0
+
+
+def _write_report(args, a) -> None:
+    """The assessment report into ``--out`` (docs/assessment.md#report)."""
+    import sys
+    import time
+
+    from ..report.build import build_scheme_report
+    from ..report.notebooks import ReportError
+    from ..report.publish import OutputFolderError
+    from .output import OutputError
+    text = None
+    if args.vehicle is not None:               # the user's file as written, comments and all
+        from ..model.vehicle_file import read_vehicle_text
+        text = read_vehicle_text(args.vehicle)
+    src = a.sources
+    residuals = {"P_N": src.loads.P_N, "T_Nm": src.loads.T_Nm, "misalignment_rad": src.misalignment_rad} \
+        if src else None
+    t0 = time.perf_counter()
+    try:
+        res = build_scheme_report(a.vehicle, args.scheme, args.out, a.tire_scale, a.load_units or None, residuals,
+                                  pdf=not args.no_pdf, paper=args.paper,
+                                  source=args.vehicle or f"preset {args.preset}", vehicle_text=text,
+                                  progress=lambda line: print(f"lcv assess: {line}", file=sys.stderr, flush=True))
+    except OutputFolderError as exc:
+        raise UsageError(f"argument {exc}") from None
+    except ReportError as exc:
+        raise OutputError(str(exc)) from None
+    for key in ("html", "pdf", "data"):
+        if key in res:
+            print(f"lcv assess: wrote {res[key]}", file=sys.stderr)
+    print(f"lcv assess: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
 
 
 def verdict_lines(a) -> list[str]:

@@ -262,6 +262,11 @@ def build_parser() -> argparse.ArgumentParser:
                      help=f"thrust angle of an axle [rad], in {_help_range('misalignment')}; repeatable or "
                           f"comma-separated")
     ass.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML): their axle P and T")
+    ass.add_argument("--out", metavar="DIR", help="also write the assessment report (HTML, PDF; the verdict table "
+                                                  "first, then the evidence of every measure): new, empty or an "
+                                                  "earlier report")
+    ass.add_argument("--no-pdf", action="store_true", help="with --out: HTML only")
+    ass.add_argument("--paper", default="letter", choices=("letter", "a4"), help="paper of the PDF (default letter)")
     ass.add_argument("--json", action="store_true", help="machine-readable output (docs/assessment.md)")
     rol = sub.add_parser("roll", help="roll: static rollover threshold per roll-coupled group (lift-off axle by "
                                       "axle), roll gains, load transfer ratios, roll modes (docs/roll.md)")

@@ -31,6 +31,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..model.vehicle import Vehicle
 from ..units import kph_to_mps
 from ..util.threads import one_blas_thread
@@ -55,6 +57,8 @@ class MeasureVerdict:
     notes: dict
     level_reached: str | None
     reason: str | None
+    #: every level's bounds as numbers, relative ones resolved: {level: (min or None, max or None)}
+    bounds: dict = dataclasses.field(default_factory=dict)
 
     @property
     def unit(self) -> str:
@@ -92,6 +96,14 @@ class SchemeAssessment:
     level_reached: str | None
     reason: str | None
     tire_scale: float = 1.0
+    load_units: tuple = ()
+    #: the residual sources beyond the 1 % rule (the crossfall: each measure's condition)
+    sources: object = None
+
+    def evidence(self, key: str):
+        """The :class:`~lcvreport.measures.evidence.Evidence` of the measure ``key``."""
+        from .evidence import evidence
+        return evidence(self, next(m for m in self.measures if m.key == key))
 
     def to_dict(self) -> dict:
         """``{"scheme", "levels", "measures": [{"key", "conditions", "value", "verdicts",
@@ -191,7 +203,8 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     elif reached != scheme.levels[0]:
         first = scheme.levels[0]
         reason = "fails " + first + ": " + ", ".join(m.key for m in measures if m.verdicts[first] != "pass")
-    return SchemeAssessment(vehicle, scheme, measures, reached, reason, float(tire_scale))
+    return SchemeAssessment(vehicle, scheme, measures, reached, reason, float(tire_scale),
+                            tuple(load_units) if load_units else (), sources)
 
 
 def _verdict(m, doc: dict, levels) -> MeasureVerdict:
@@ -210,4 +223,8 @@ def _verdict(m, doc: dict, levels) -> MeasureVerdict:
     else:
         reason = None
     limits = {level: m.limits[level].text() for level in levels}
-    return MeasureVerdict(m.key, dict(m.conditions), value, verdicts, limits, notes, reached, reason)
+    bounds = {}
+    for level in levels:
+        lim = m.limits[level].resolved(lambda k: doc.get(k))
+        bounds[level] = tuple(None if b is None or not np.isfinite(b) else float(b) for b in (lim.min, lim.max))
+    return MeasureVerdict(m.key, dict(m.conditions), value, verdicts, limits, notes, reached, reason, bounds)

@@ -174,6 +174,52 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
                          progress, fast)
 
 
+def build_scheme_report(vehicle, scheme_file: str | Path, out_dir: str | Path, tire_scale: float = 1.0,
+                        load_units=None, residuals: dict | None = None, pdf: bool = True, paper: str = "letter",
+                        source: str = "", vehicle_text: str | None = None, fast: bool = False,
+                        progress: Callable[[str], None] | None = None) -> dict:
+    """The report of an assessment against a scheme (``lcv assess --out DIR``, docs/assessment.md):
+    its first page the verdict table, then the limits with their sources and the evidence of
+    every measure with the limits drawn on it.  The folder is self-contained -- the vehicle file
+    and the scheme file copied in as ``vehicle.toml`` and ``scheme.toml``, MathJax copied, not
+    linked -- and the report names the toolkit's version and both files' SHA-256.  Written
+    aside and moved into place whole, as :func:`build_assessment`.
+
+    Returns
+    -------
+    dict
+        ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
+    """
+    import hashlib
+
+    from ..measures.scheme import load_scheme
+    from ..model.vehicle_file import dumps_vehicle
+    version, progress = _start(paper, progress)
+    scheme_bytes = Path(scheme_file).read_bytes()
+    scheme = load_scheme(scheme_file)
+    text = vehicle_text if vehicle_text is not None else \
+        dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name}).")
+    sha_vehicle = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    sha_scheme = hashlib.sha256(scheme_bytes).hexdigest()
+
+    def params_of(staged: Path) -> dict:
+        (staged / "vehicle.toml").write_text(text, encoding="utf-8")
+        (staged / "scheme.toml").write_bytes(scheme_bytes)
+        return {"vehicle_file": str(staged / "vehicle.toml"), "scheme_file": str(staged / "scheme.toml"),
+                "source": source or None, "tire_scale": float(tire_scale),
+                "load_units": list(load_units) if load_units else None, "residuals": residuals}
+
+    title = f"Assessment of {vehicle.name} against {scheme.name}"
+    intro = (f"*{md_text(vehicle.name)}* ({vehicle.n_units} units){' from ' + md_text(source) if source else ''} "
+             f"assessed against *{md_text(scheme.name)}* (status: {md_text(scheme.status)}), every measure at its "
+             f"own conditions, by lcvreport {version} on {{stamp}}. Vehicle file (vehicle.toml beside this report) "
+             f"SHA-256 `{sha_vehicle}`; scheme file (scheme.toml) SHA-256 `{sha_scheme}`.")
+    out = _one_notebook(out_dir, "scheme", params_of, title, intro, pdf, paper, f"lcvreport {version} (lcv assess)",
+                        f"lcvreport {version} (lcv assess)", progress, fast, toc=False)
+    out["sha256"] = {"vehicle.toml": sha_vehicle, "scheme.toml": sha_scheme}
+    return out
+
+
 def _start(paper: str, progress) -> tuple[str, Callable[[str], None]]:
     """The package's version and the progress callback, once the paper size is checked."""
     from importlib.metadata import version
@@ -183,7 +229,7 @@ def _start(paper: str, progress) -> tuple[str, Callable[[str], None]]:
 
 
 def _one_notebook(out_dir, stem: str, params_of, title: str, intro: str, pdf: bool, paper: str, pdf_title: str,
-                  written_by: str, progress, fast: bool) -> dict:
+                  written_by: str, progress, fast: bool, toc: bool = True) -> dict:
     """A one-notebook report: ``out_dir`` checked, the report written aside -- its ``data/``,
     the notebook ``stem`` executed with ``fast``, ``data_dir`` and ``params_of(staged)``,
     merged under ``title`` and ``intro`` (``{stamp}``: the date), exported -- and published
@@ -203,7 +249,7 @@ def _one_notebook(out_dir, stem: str, params_of, title: str, intro: str, pdf: bo
         progress(f"notebook {stem}: {time.perf_counter() - t0:.1f} s")
         stamp = time.strftime("%Y-%m-%d", time.gmtime(int(os.environ.get("SOURCE_DATE_EPOCH", time.time()))))
         written = _finish_single(staged, out, before, (stem, stem, title, path), title,
-                                 intro.replace("{stamp}", stamp), pdf, pdf_title, paper, written_by, progress)
+                                 intro.replace("{stamp}", stamp), pdf, pdf_title, paper, written_by, progress, toc)
     except BaseException as exc:
         _discard(staged, isinstance(exc, KeyboardInterrupt))
         raise
@@ -213,7 +259,7 @@ def _one_notebook(out_dir, stem: str, params_of, title: str, intro: str, pdf: bo
 
 
 def _finish_single(staged: Path, out: Path, before, part: tuple, title: str, intro: str, pdf: bool, pdf_title: str,
-                   paper: str, written_by: str, progress) -> dict:
+                   paper: str, written_by: str, progress, toc: bool = True) -> dict:
     """The end of a one-notebook report (the assessment, a study): merge, HTML, PDF, the
     manifest, then the staged folder published into ``out``; the files written, by kind."""
     import json
@@ -222,7 +268,7 @@ def _finish_single(staged: Path, out: Path, before, part: tuple, title: str, int
     progress("html written")
     written = {"html": "index.html", "data": "data"}
     if pdf:
-        export_pdf(nb, staged, pdf_title, paper=paper, title_page=False)
+        export_pdf(nb, staged, pdf_title, paper=paper, title_page=False, toc=toc)
         written["pdf"] = "report.pdf"
         progress("pdf written")
     files = sorted(p.name for p in staged.iterdir()) + [MANIFEST]

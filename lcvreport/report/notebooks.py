@@ -193,7 +193,44 @@ def _study_dir(name, value, _ctx):
 STUDY = NotebookSpec("study", "study", "Study", {**_COMMON, "study_dir": _study_dir, "criteria_file": _text_or_none})
 
 
-SPECS = {s.stem: s for s in NOTEBOOKS + (ASSESSMENT, STUDY)}
+def _scheme_file(name, value, _ctx):
+    from ..measures.scheme import SchemeError, load_scheme
+    if not isinstance(value, str):
+        raise ReportError(f"parameter {name} must be the path of a scheme file, got {value!r}")
+    try:
+        load_scheme(value)
+    except SchemeError as exc:
+        raise ReportError(f"parameter {name} {value}: {exc}") from None
+
+
+def _tire_scale(name, value, _ctx):
+    from ..ranges import RANGES
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not RANGES["tire_scale"].contains(value):
+        raise ReportError(f"parameter {name} must be in {RANGES['tire_scale'].text()}, got {value!r}")
+
+
+def _scheme_vehicle(name, value, ctx):
+    if not isinstance(value, str):
+        raise ReportError(f"parameter {name} must be the path of a vehicle file, got {value!r}")
+    ctx["vehicle"] = _assessment_vehicle(None, value)
+
+
+def _scheme_residuals(name, value, ctx):
+    if isinstance(value, dict) and "crossfall_percent" in value:
+        raise ReportError(f"parameter {name}: the crossfall is a condition of the scheme (crossfall_percent per "
+                          "measure), not a residual source here")
+    _residuals(name, value, ctx)
+
+
+#: the scheme assessment report's notebook (lcv assess --out): the vehicle file is read first, so
+#: that the loads and residual sources are checked against its units and axles
+SCHEME = NotebookSpec("scheme", "scheme", "Assessment against a scheme",
+                      {**_COMMON, "vehicle_file": _scheme_vehicle, "scheme_file": _scheme_file,
+                       "source": _text_or_none, "tire_scale": _tire_scale, "load_units": _load_units,
+                       "residuals": _scheme_residuals})
+
+
+SPECS = {s.stem: s for s in NOTEBOOKS + (ASSESSMENT, STUDY, SCHEME)}
 
 
 def check_notebook_parameters(stem: str, values: dict, strict: bool = True) -> None:
@@ -219,6 +256,9 @@ def check_notebook_parameters(stem: str, values: dict, strict: bool = True) -> N
         raise ReportError(f"notebook {stem} has no parameter {unknown[0]!r}; its parameters: "
                           f"{', '.join(spec.parameters)}")
     ctx: dict = {}
+    if stem == "scheme":
+        ctx["optional_loads"] = True
+        _scheme_vehicle("vehicle_file", params.get("vehicle_file"), ctx)
     if stem == "assessment":
         ctx["optional_loads"] = True
         if (params.get("preset") is None) == (params.get("vehicle_file") is None):
@@ -343,8 +383,27 @@ def merge(executed: list[tuple[str, str, str, Path]], title: str, intro: str):
     return nb
 
 
+#: the part of MathJax 2 (Debian's libjs-mathjax, 54 MB in all) the reports' configuration
+#: ``TeX-AMS_CHTML-full,Safe`` loads: the loader, the combined configuration, the TeX input and
+#: CommonHTML output jax, the extensions (Safe, the menu and zoom loaded on use) and the TeX web
+#: fonts -- 1.6 MB, copied into every report so that a copied folder keeps its mathematics
+MATHJAX_PARTS = ("MathJax.js", "config/TeX-AMS_CHTML-full.js", "extensions", "jax/input/TeX", "jax/output/CommonHTML",
+                 "jax/element", "fonts/HTML-CSS/TeX/woff")
+
+
+def copy_mathjax(dst: Path) -> None:
+    """Copy :data:`MATHJAX_PARTS` of the machine's MathJax into ``dst`` (real files, no links)."""
+    for part in MATHJAX_PARTS:
+        src, target = MATHJAX / part, dst / part
+        target.parent.mkdir(parents=True, exist_ok=True)
+        if src.is_dir():
+            shutil.copytree(src, target, symlinks=False, dirs_exist_ok=True)
+        else:
+            shutil.copyfile(src, target)
+
+
 def export_html(nb, out_dir: Path) -> Path:
-    """Self-contained HTML (figures inline), MathJax copied next to it."""
+    """Self-contained HTML (figures inline), the MathJax it needs copied next to it."""
     from nbconvert import HTMLExporter
     exporter = HTMLExporter(template_name="lab", exclude_input=True, exclude_input_prompt=True,
                             exclude_output_prompt=True, embed_images=True)
@@ -353,18 +412,17 @@ def export_html(nb, out_dir: Path) -> Path:
     body, _ = exporter.from_notebook_node(nb)
     body = body.replace('<script src=""></script>', "")
     if MATHJAX.exists():
-        # one copy on the machine (Debian's libjs-mathjax, 32 MB), linked, not copied per report
-        dst = out_dir / "mathjax"
-        if not dst.exists() and not dst.is_symlink():
-            dst.symlink_to(MATHJAX, target_is_directory=True)
+        copy_mathjax(out_dir / "mathjax")
     path = out_dir / "index.html"
     path.write_text(body, encoding="utf-8")
     return path
 
 
-def export_pdf(nb, out_dir: Path, author: str, paper: str = "letter", title_page: bool = True) -> Path:
-    """PDF through nbconvert's LaTeX route (xelatex) with the lcvlatex template; the LaTeX
-    log of the last run is kept as ``latex.log`` beside it (see :func:`overfull_boxes`)."""
+def export_pdf(nb, out_dir: Path, author: str, paper: str = "letter", title_page: bool = True,
+               toc: bool = True) -> Path:
+    """PDF through nbconvert's LaTeX route (xelatex) with the lcvlatex template (``toc``: a table
+    of contents after the title); the LaTeX log of the last run is kept as ``latex.log`` beside
+    it (see :func:`overfull_boxes`)."""
     from nbconvert import PDFExporter
 
     class _Exporter(PDFExporter):
@@ -381,7 +439,8 @@ def export_pdf(nb, out_dir: Path, author: str, paper: str = "letter", title_page
     exporter.latex_command = ["xelatex", "-interaction=batchmode", "-halt-on-error", "{filename}"]
     try:
         pdf, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": "report"}, "lcv_author": author,
-                                                              "lcv_paper": paper, "lcv_title_page": title_page})
+                                                              "lcv_paper": paper, "lcv_title_page": title_page,
+                                                              "lcv_toc": toc})
     except Exception as exc:  # nbconvert raises LatexFailed with the log
         raise ReportError(f"PDF export (xelatex) failed: {str(exc)[-2000:]}") from None
     path = out_dir / "report.pdf"

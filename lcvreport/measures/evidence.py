@@ -1,0 +1,95 @@
+"""The evidence of an assessment: for each measure of a scheme, what it was read from, computed
+again at the measure's conditions -- the manoeuvre's time history, the turn's swept path, the
+tilt curve -- so that a report can draw it with the limits on it (docs/assessment.md).
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> from lcvreport.measures.scheme import loads_scheme
+>>> from lcvreport.measures.assess import assess
+>>> s = loads_scheme('scheme = "e"\\nlevels = ["L1"]\\n[measures.hsto_m]\\nspeed_kph = 88.0\\nsource = "p"\\n'
+...                  'levels = { L1 = { max = 1.0 } }')
+>>> a = assess(load_preset("tractor_semitrailer"), s)
+>>> e = evidence(a, a.measures[0])
+>>> e.kind, round(e.result.hsto_m, 4) == round(a.measures[0].value, 4)
+('lane_change', True)
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from ..units import kph_to_mps
+from .registry import CONDITIONS, MEASURES
+
+#: what each family's evidence is
+KINDS = {"lane_change": "lane_change", "single_sine": "single_sine", "yaw_damping": "pulse",
+         "low_speed_turn": "swept_path", "rollover": "tilt", "straight_path": "straight_path"}
+#: the roll family's measures read from its lane change, and from its single sine
+ROLL_LANE_CHANGE = ("ra_lane_change_roll", "hsto_m_roll", "rltr_lane_change")
+ROLL_SINGLE_SINE = ("ra_single_sine_roll",)
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """What one measure was read from: ``kind`` (``lane_change``, ``single_sine``, ``pulse``,
+    ``swept_path``, ``tilt``, ``straight_path``; ``value`` for a measure drawn as its value
+    against the limits), the ``result`` object (None for ``value``), the ``verdict`` and the
+    scheme's ``levels``.  ``plot()`` draws it with the limits on it."""
+
+    kind: str
+    result: object
+    verdict: object
+    levels: tuple
+    model: str = "yaw_plane"
+
+    def plot(self):
+        """The evidence with every level's limit drawn (a :class:`matplotlib.figure.Figure`)."""
+        from ..plotting.assessment import fig_evidence
+        return fig_evidence(self)
+
+
+def evidence(assessment, verdict) -> Evidence:
+    """The evidence of ``verdict`` (one measure of ``assessment``), recomputed at its conditions.
+
+    Parameters
+    ----------
+    assessment : lcvreport.measures.assess.SchemeAssessment
+    verdict : lcvreport.measures.assess.MeasureVerdict
+    """
+    v, c, s = assessment.vehicle, verdict.conditions, assessment.tire_scale
+    key = verdict.key
+    family = MEASURES[key].family
+    speed = kph_to_mps(c.get("speed_kph", 88.0))
+    levels = assessment.scheme.levels
+    if verdict.value is None:
+        return Evidence("value", None, verdict, levels)
+    lane = (c.get("lane_change_ay_g", CONDITIONS["lane_change_ay_g"].default),
+            c.get("lane_change_frequency_hz", CONDITIONS["lane_change_frequency_hz"].default))
+    f_hz = c.get("ra_frequency_hz", CONDITIONS["ra_frequency_hz"].default)
+    if family == "lane_change" or key in ROLL_LANE_CHANGE:
+        from .offtracking import lane_change_measures
+        model = "yaw_roll" if key in ROLL_LANE_CHANGE else "yaw_plane"
+        return Evidence("lane_change", lane_change_measures(v, speed, s, *lane, model=model), verdict, levels, model)
+    if family == "single_sine" or key in ROLL_SINGLE_SINE:
+        from .amplification import single_sine
+        model = "yaw_roll" if key in ROLL_SINGLE_SINE else "yaw_plane"
+        return Evidence("single_sine", single_sine(v, speed, f_hz, tire_scale=s, model=model), verdict, levels, model)
+    if family == "yaw_damping":
+        from .yaw_damping import yaw_damping_coefficient
+        return Evidence("pulse", yaw_damping_coefficient(v, speed, s), verdict, levels)
+    if family == "low_speed_turn":
+        from .low_speed import low_speed_turn
+        return Evidence("swept_path", low_speed_turn(v, c["turn_radius_m"], c["turn_angle_deg"]), verdict, levels)
+    if family == "rollover":
+        from .rollover import rollover_threshold
+        return Evidence("tilt", rollover_threshold(v), verdict, levels, "yaw_roll")
+    if family == "straight_path":
+        from ..model.yaw_plane.loads import ResidualSources
+        from .measure_set import residual_force
+        from .offtracking import straight_path
+        src = dataclasses.replace(assessment.sources or ResidualSources(),
+                                  crossfall_percent=c.get("crossfall_percent", 0.0))
+        F = residual_force(v, assessment.load_units, src if src else None, s)
+        return Evidence("straight_path", straight_path(v, speed, F, s), verdict, levels)
+    return Evidence("value", None, verdict, levels)
