@@ -103,6 +103,12 @@ def _cmd_study(args, out: _Out) -> int:
         study = load_study(args.study_file)
     except StudyError as exc:
         raise UsageError(str(exc) if str(args.study_file) in str(exc) else f"{args.study_file}: {exc}") from None
+    if args.scheme is not None:
+        from ..measures.scheme import SchemeError, read_scheme_text
+        try:
+            study = study.with_scheme(read_scheme_text(args.scheme))
+        except (SchemeError, StudyError) as exc:
+            raise UsageError(f"argument --scheme {args.scheme}: {exc}") from None
     out_dir = Path(args.out)
     if args.scheduler is not None:
         from ..study.run import check_scheduler_address
@@ -126,7 +132,8 @@ def _cmd_study(args, out: _Out) -> int:
     if not args.json:
         seed = f", seed {study.seed}" if study.seed is not None else ""
         out.line(f"study of {study.vehicle.name}: {study.kind} design{seed}, {study.n_cases} cases in "
-                 f"{study.n_chunks} chunks of {study.chunk}; measures {', '.join(study.measures)}")
+                 f"{study.n_chunks} chunks of {study.chunk}; measures {', '.join(study.measures)}"
+                 + (f"; every case assessed against {study.scheme.name}" if study.scheme_toml else ""))
         for f in study.factors:
             out.line(f"  {f.describe()}")
         out.stream.flush()

@@ -245,6 +245,9 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--report", metavar="REPORT_DIR", help="then write the study report (HTML, PDF) into REPORT_DIR: "
                                                            "new, empty or an earlier report")
     st.add_argument("--criteria", metavar="FILE", help="with --report: limits to judge the cases by (TOML)")
+    st.add_argument("--scheme", metavar="FILE", help="assess every case against a scheme file (docs/assessment.md): "
+                                                     "the level each measure and the case reach as columns, and in "
+                                                     "the report the share of cases reaching each level")
     st.add_argument("--no-pdf", action="store_true", help="with --report: HTML only")
     st.add_argument("--json", action="store_true", help="machine-readable summary")
     ass = sub.add_parser("assess", help="a performance-based standards assessment: every measure of a scheme file "

@@ -105,6 +105,17 @@ def load_scheme(path: str | Path) -> Scheme:
     return _scheme(doc, str(path))
 
 
+def read_scheme_text(path: str | Path) -> str:
+    """The text of the scheme file ``path``, checked (:func:`load_scheme`'s refusals)."""
+    from ..util.files import read_text_file
+    try:
+        text = read_text_file(path, "scheme file")
+    except FileInputError as exc:
+        raise SchemeError(str(exc)) from None
+    loads_scheme(text)
+    return text
+
+
 def loads_scheme(text: str) -> Scheme:
     """:func:`load_scheme` of a TOML text."""
     import tomllib

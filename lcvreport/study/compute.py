@@ -62,6 +62,8 @@ def compute_chunk(study: Study, case_ids) -> dict:
                 for name, arr in zip(BATCH_GROUPS[group], arrays):
                     if name in batched:
                         cols[name][rows] = np.broadcast_to(arr, rows.shape)
+    if study.scheme_toml is not None:
+        cols.update(scheme_columns(study, ids))
     rest = [m for m in study.measures if m not in batched]
     if rest:
         for k, case_id in enumerate(ids):
@@ -70,6 +72,29 @@ def compute_chunk(study: Study, case_ids) -> dict:
             for m in rest:
                 value = values.get(m)
                 cols[m][k] = np.nan if value is None else float(value)
+    return cols
+
+
+def scheme_columns(study: Study, ids: np.ndarray) -> dict:
+    """The assessment of every case against the study's scheme (docs/studies.md#schemes):
+    ``scheme.<key>`` each scheme measure's value at its conditions (NaN: not computed),
+    ``level.<key>`` the level it reaches and ``level_reached`` the case's ("" for none), each
+    case as :func:`lcvreport.measures.assess.assess` of its vehicle (one case at a time)."""
+    from ..measures.assess import assess
+    scheme = study.scheme
+    keys = [m.key for m in scheme.measures]
+    cols = {f"scheme.{k}": np.full(ids.size, np.nan) for k in keys}
+    levels = {f"level.{k}": [] for k in keys}
+    reached = []
+    for k, case_id in enumerate(ids):
+        vehicle, _speed, kwargs = study.case(int(case_id))
+        a = assess(vehicle, scheme, kwargs.get("tire_scale", 1.0), kwargs.get("load_units"), kwargs.get("sources"))
+        for m in a.measures:
+            cols[f"scheme.{m.key}"][k] = np.nan if m.value is None else float(m.value)
+            levels[f"level.{m.key}"].append(m.level_reached or "")
+        reached.append(a.level_reached or "")
+    cols.update({name: np.array(v, dtype=object) for name, v in levels.items()})
+    cols["level_reached"] = np.array(reached, dtype=object)
     return cols
 
 

@@ -42,7 +42,7 @@ def _checked(folder: Path) -> tuple[dict, object]:
         raise StudyError(f"{folder / MANIFEST} does not describe the study in {folder / STUDY} (another study's, "
                          "or changed); the results cannot be trusted: run the study again into a new folder")
     for key, want in (("n_cases", study.n_cases), ("chunk_size", study.chunk), ("n_chunks", study.n_chunks),
-                      ("columns", ["case_id"] + [f.name for f in study.factors] + list(study.measures))):
+                      ("columns", study.columns)):
         if man.get(key) != want:
             raise StudyError(f"{folder / MANIFEST}: {key} is {man.get(key)!r} but the study has {want!r} (the "
                              "manifest was changed); run the study again into a new folder")

@@ -178,7 +178,7 @@ def _prepare(study: Study, out: Path) -> Path:
                     e.unlink()
         out.mkdir(parents=True, exist_ok=True)
         (out / CHUNKS).mkdir(exist_ok=True)
-        columns = ["case_id"] + [f.name for f in study.factors] + list(study.measures)
+        columns = study.columns
         manifest = {"format": FORMAT, "study_sha256": digest, "n_cases": study.n_cases, "chunk_size": study.chunk,
                     "n_chunks": study.n_chunks, "columns": columns, "seed": study.seed, "kind": study.kind}
         _write_json(out, STUDY, json.dumps(doc, indent=1))

@@ -120,6 +120,47 @@ class Study:
     seed: int | None = None
     speed_kph: float | None = None
     chunk_size: int = 0
+    #: the text of a scheme file every case is assessed against (``lcv study --scheme``), or None
+    scheme_toml: str | None = None
+
+    @property
+    def scheme(self):
+        """The :class:`~lcvreport.measures.scheme.Scheme` of :attr:`scheme_toml` (None without one)."""
+        if self.scheme_toml is None:
+            return None
+        from ..measures.scheme import loads_scheme
+        return loads_scheme(self.scheme_toml)
+
+    def with_scheme(self, text: str) -> "Study":
+        """The study with every case assessed against the scheme file ``text`` (the level each
+        measure and the case reach as columns, docs/studies.md#schemes).
+
+        Raises
+        ------
+        lcvreport.measures.scheme.SchemeError
+            A bad scheme.
+        StudyError
+            A factor the scheme fixes itself: the speed (each measure's ``speed_kph``) or the
+            crossfall (a condition).
+        """
+        from ..measures.scheme import loads_scheme
+        loads_scheme(text)
+        for f in self.factors:
+            if f.name in ("speed_kph", "speed_mps", "crossfall_percent"):
+                what = "speed" if f.name.startswith("speed") else "crossfall"
+                raise StudyError(f"factors.{f.name}: the scheme fixes each measure's {what} itself; a study with "
+                                 f"--scheme varies the vehicle, not the {what}")
+        return replace(self, scheme_toml=text)
+
+    @property
+    def columns(self) -> list[str]:
+        """The results' columns, in order: ``case_id``, the factors, the measures, and with a
+        scheme ``scheme.<key>`` and ``level.<key>`` per scheme measure and ``level_reached``."""
+        cols = ["case_id"] + [f.name for f in self.factors] + list(self.measures)
+        if self.scheme_toml is not None:
+            keys = [m.key for m in self.scheme.measures]
+            cols += [f"scheme.{k}" for k in keys] + [f"level.{k}" for k in keys] + ["level_reached"]
+        return cols
 
     # ------------------------------------------------------------------ cases
     @property
@@ -340,9 +381,12 @@ class Study:
     def to_dict(self) -> dict:
         """The study as a plain document (its vehicle as vehicle-file text): stored with the
         results, and hashed to tell a rerun of the same study from another."""
-        return {"vehicle_toml": dumps_vehicle(self.vehicle), "kind": self.kind, "count": self.count,
-                "seed": self.seed, "speed_kph": self.speed_kph, "measures": list(self.measures),
-                "chunk_size": self.chunk, "factors": [f.__dict__ | {"values": list(f.values)} for f in self.factors]}
+        doc = {"vehicle_toml": dumps_vehicle(self.vehicle), "kind": self.kind, "count": self.count,
+               "seed": self.seed, "speed_kph": self.speed_kph, "measures": list(self.measures),
+               "chunk_size": self.chunk, "factors": [f.__dict__ | {"values": list(f.values)} for f in self.factors]}
+        if self.scheme_toml is not None:          # (absent otherwise: earlier studies keep their digest)
+            doc["scheme_toml"] = self.scheme_toml
+        return doc
 
     def digest(self) -> str:
         return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()
@@ -565,4 +609,4 @@ def study_from_stored(doc: dict) -> Study:
     factors = tuple(Factor(**(f | {"values": tuple(tuple(x) if isinstance(x, list) else x for x in f["values"])}))
                     for f in doc["factors"])
     return Study(loads_vehicle(doc["vehicle_toml"]), factors, doc["kind"], tuple(doc["measures"]), doc["count"],
-                 doc["seed"], doc["speed_kph"], doc["chunk_size"])
+                 doc["seed"], doc["speed_kph"], doc["chunk_size"], doc.get("scheme_toml"))

@@ -106,3 +106,42 @@ def pass_rates(table, criteria, factors, bins: int = 8) -> PassRates:
                                    if ((which == b) & judged).any() else np.nan for b in range(centres.size)])
         by_factor[f] = (centres, rates)
     return PassRates(overall, by_factor)
+
+
+def level_shares(table, scheme) -> list[dict]:
+    """The share of a study's cases reaching each level of ``scheme`` (the columns of
+    ``lcv study --scheme``, docs/studies.md#schemes): per level, in the scheme's order (most
+    demanding first), the cases whose ``level_reached`` is that level, and those reaching it or
+    a more demanding one; then the cases reaching no level; a row per measure follows with the
+    cases each measure takes to each level.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from lcvreport.measures.scheme import loads_scheme
+    >>> s = loads_scheme('scheme = "s"\\nlevels = ["L1", "L2"]\\n[measures.lssp_m]\\nsource = "p"\\n'
+    ...                  'levels = { L1 = { max = 7.0 }, L2 = { max = 9.0 } }')
+    >>> t = pd.DataFrame({"level_reached": ["L1", "L2", "", "L2"], "level.lssp_m": ["L1", "L2", "", "L2"]})
+    >>> [(r["level"], r["cases"], r["at least"]) for r in level_shares(t, s)][:3]
+    [('L1', 1, 1), ('L2', 2, 3), ('none', 1, 4)]
+    """
+    n = len(table)
+    rows = []
+    reached = table["level_reached"].astype(str).to_numpy()
+    cumulative = 0
+    for level in [*scheme.levels, ""]:
+        count = int((reached == level).sum())
+        cumulative += count
+        rows.append({"what": "the case", "level": level or "none", "cases": count,
+                     "share": count / n if n else math.nan, "at least": cumulative,
+                     "share at least": cumulative / n if n else math.nan})
+    for m in scheme.measures:
+        col = table[f"level.{m.key}"].astype(str).to_numpy()
+        cumulative = 0
+        for level in [*scheme.levels, ""]:
+            count = int((col == level).sum())
+            cumulative += count
+            rows.append({"what": m.key, "level": level or "none", "cases": count,
+                         "share": count / n if n else math.nan, "at least": cumulative,
+                         "share at least": cumulative / n if n else math.nan})
+    return rows
