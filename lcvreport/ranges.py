@@ -30,6 +30,8 @@ misalignment           rad            [-0.05, 0.05]       thrust angle of an axl
 crossfall              %              [-20, 20]           road crossfall (crown ~2 %)
 lane_change_ay         g              (0, 2]              a measure's lane change A0
 steady_turn_radius     m              [20, 10000]         the HSSO turn (393 m by default)
+driver_gain            rad/m          (0, 1]              the preview driver's gain
+driver_preview         s              [0, 5]              its look-ahead time
 =====================  =============  ==================  ==============================
 
 The vehicle-file limits (:data:`VEHICLE`) are as generous: they exist so that a
@@ -157,6 +159,10 @@ RANGES: dict[str, Range] = dict([
     ("crossfall", Range("crossfall", "%", -20.0, 20.0, description="road crossfall, positive falling toward +y")),
     ("lane_change_ay", Range("lane change A0", "g", 0.0, 2.0, low_open=True,
                              description="amplitude of the steered axle's lateral acceleration in a lane change")),
+    ("driver_gain", Range("driver gain", "rad/m", 0.0, 1.0, low_open=True,
+                          description="the preview driver's steer per metre of lateral error")),
+    ("driver_preview", Range("driver preview", "s", 0.0, 5.0,
+                             description="the preview driver's look-ahead time")),
     ("steady_turn_radius", Range("steady turn radius", "m", 20.0, 10000.0,
                                  description="radius of the high-speed steady turn (u/R the tractor's yaw rate)")),
     ("turn_radius", Range("turn radius", "m", 2.0, 100.0,

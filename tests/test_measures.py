@@ -240,7 +240,7 @@ SPEC_KEYS = {"speed_mps", "least_damping_ratio", "least_damped_frequency_hz", "c
              "ra_single_sine_roll", "ltr_single_sine", "ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change",
              "rltr_lane_change", "roll_gain_deg_per_g",
              # the assessment's measures (docs/measures.md): yaw-rate RA, tracking on a straight path
-             "ra_yaw_rate_single_sine", "tasp_m"}
+             "ra_yaw_rate_single_sine", "tasp_m", "hsto_driver_m", "ra_lane_change_driver"}
 
 
 @pytest.mark.parametrize("source", [["--preset", "aucnat"]] + [["--vehicle", str(EXAMPLES / f"{n}.toml")]

@@ -139,7 +139,8 @@ def build_parser() -> argparse.ArgumentParser:
     residuals(sim)
     sim.add_argument("--steer", metavar="SPEC", default=None,
                      help="steer input: step:A, sine:A:F, pulse:A:D, csv:FILE, lane-change:A0:F (A0 in m/s^2 or "
-                          "with g, e.g. 0.15g); default none")
+                          "with g, e.g. 0.15g), driver:A0:F[:K:T] (that path driven in closed loop by a preview "
+                          "driver, gain K rad/m, preview T s); default none")
     sim.add_argument("--t-end", default=10.0, type=_ranged("t_end", what="end time in s"), metavar="T",
                      help=f"end time [s], in {_help_range('t_end')}; default 10")
     sim.add_argument("--model", default="yaw-plane", choices=("yaw-plane", "yaw-roll"),

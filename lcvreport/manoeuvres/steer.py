@@ -13,6 +13,10 @@ response to it is exact (the exponential of the state matrix augmented with ``E`
 ``lane-change:A0:F``   the steer that makes the steered axle's lateral acceleration
                        A0 sin(2 pi F t) for 0 <= t <= 1/F, then 0 (A0 in m/s^2, or
                        with a ``g`` suffix in g: ``0.15g``)
+``driver:A0:F[:K:T]``  the preview driver in closed loop following the lane change's
+                       path: delta = K (Y_path(t) - (Y1 + u T psi1)), the path point
+                       the tractor reaches T seconds later (gain K [rad/m], default
+                       0.2; preview T [s], default 0.5)
 =====================  ================================================================
 
 Examples
@@ -117,6 +121,9 @@ class SteerInput:
     amplitude: float = 0.0
     frequency_hz: float = float("nan")
     prescribes_acceleration: bool = field(default=False)
+    #: the preview driver's (gain [rad/m], preview time [s]) when the pieces are its reference
+    #: path [m] (``driver:``), else None
+    driver: tuple | None = None
 
     def delta(self, t) -> np.ndarray:
         """The input's value at times ``t`` [s] (rad; m/s^2 for a lane change)."""
@@ -219,6 +226,33 @@ def lane_change(accel_mps2: float, frequency_hz: float) -> SteerInput:
                       f"lane-change:{A0:g}:{F:g}", A0, F, prescribes_acceleration=True)
 
 
+#: the preview driver of ``driver:``: gain [rad/m] and preview time [s]
+DRIVER_GAIN_RAD_PER_M = 0.2
+DRIVER_PREVIEW_S = 0.5
+
+
+def driver_lane_change(accel_mps2: float, frequency_hz: float, gain_rad_per_m: float = DRIVER_GAIN_RAD_PER_M,
+                       preview_s: float = DRIVER_PREVIEW_S) -> SteerInput:
+    """The closed-loop lane change: a preview driver steers ``delta = K (Y_path(t) - (Y1 + u T
+    psi1))`` -- the lateral position the tractor's CG would reach T seconds ahead on its heading
+    against the path there -- along the lane change's path ``Y_path`` (lateral acceleration
+    A0 sin(2 pi F s) for 0 <= s <= 1/F of path time s, the path point reached T later: the
+    tractor enters the lane change at t = T).  The pieces are the path [m]; the response is exact
+    for the closed loop (:func:`lcvreport.analysis.exact.response`)."""
+    A0 = RANGES["lateral_acceleration"].check(accel_mps2, "driver lane-change acceleration")
+    F = RANGES["frequency"].check(frequency_hz, "driver lane-change frequency")
+    K = RANGES["driver_gain"].check(gain_rad_per_m, "driver gain")
+    T_p = RANGES["driver_preview"].check(preview_s, "driver preview")
+    T, w = 1.0 / F, 2 * math.pi * F
+    # Y_path = A0/w (t - sin(w t)/w) on [0, T): a line and a sinusoid together; then the offset
+    line, sinus = _line(0.0, T, 0.0, A0 / w), _sinusoid(0.0, T, -A0 / w ** 2, w)
+    E = np.zeros((4, 4))
+    E[:2, :2], E[2:, 2:] = line.E, sinus.E
+    path = Piece(0.0, T, E, np.r_[line.h, sinus.h], np.r_[line.xi0, sinus.xi0])
+    return SteerInput("driver", (path, _constant(T, math.inf, A0 / (w * F))), T,
+                      f"driver:{A0:g}:{F:g}:{K:g}:{T_p:g}", A0, F, driver=(K, T_p))
+
+
 def lane_change_offset_m(steer: SteerInput) -> float:
     """The final lateral offset of the steered axle in a lane change, A0 / (2 pi F^2) [m]."""
     return steer.amplitude / (2 * math.pi * steer.frequency_hz ** 2)
@@ -242,7 +276,7 @@ def parse_steer(spec: str) -> SteerInput:
     SteerError
         Naming the part of ``spec`` that is wrong and what is valid.
     """
-    kinds = "step:A, sine:A:F, pulse:A:D, csv:FILE, lane-change:A0:F"
+    kinds = "step:A, sine:A:F, pulse:A:D, csv:FILE, lane-change:A0:F, driver:A0:F[:K:T]"
     kind, _, rest = spec.partition(":")
     parts = rest.split(":") if rest else []
     try:
@@ -250,9 +284,17 @@ def parse_steer(spec: str) -> SteerInput:
             if not rest:
                 raise SteerError(f"steer {spec!r}: csv needs a file, csv:FILE")
             return read_table(rest)
-        expected = {"step": 1, "sine": 2, "pulse": 2, "lane-change": 2}
+        expected = {"step": 1, "sine": 2, "pulse": 2, "lane-change": 2, "driver": 2}
         if kind not in expected:
             raise SteerError(f"steer {spec!r}: unknown kind {kind!r}; valid: {kinds}")
+        if kind == "driver" and len(parts) in (2, 4):
+            a = parts[0].strip()
+            A0 = _number(a[:-1], "A0 [g]", spec) * G_MPS2 if a.lower().endswith("g") else \
+                _number(a, "A0 [m/s^2]", spec)
+            extra = [_number(parts[2], "K [rad/m]", spec), _number(parts[3], "T [s]", spec)] if len(parts) == 4 else []
+            return driver_lane_change(A0, _number(parts[1], "F [Hz]", spec), *extra)
+        if kind == "driver":
+            raise SteerError(f"steer {spec!r}: driver takes A0:F or A0:F:K:T; valid: {kinds}")
         if len(parts) != expected[kind]:
             raise SteerError(f"steer {spec!r}: {kind} takes {expected[kind]} number(s); valid: {kinds}")
         if kind == "step":

@@ -71,6 +71,11 @@ def evidence(assessment, verdict) -> Evidence:
         from .offtracking import lane_change_measures
         model = "yaw_roll" if key in ROLL_LANE_CHANGE else "yaw_plane"
         return Evidence("lane_change", lane_change_measures(v, speed, s, *lane, model=model), verdict, levels, model)
+    if family == "driver_lane_change":
+        from .offtracking import driver_lane_change_measures
+        K = c.get("driver_gain_rad_per_m", CONDITIONS["driver_gain_rad_per_m"].default)
+        T = c.get("driver_preview_s", CONDITIONS["driver_preview_s"].default)
+        return Evidence("lane_change", driver_lane_change_measures(v, speed, s, *lane, K, T), verdict, levels)
     if family == "single_sine" or key in ROLL_SINGLE_SINE:
         from .amplification import single_sine
         model = "yaw_roll" if key in ROLL_SINGLE_SINE else "yaw_plane"

@@ -91,6 +91,37 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
     return LaneChangeMeasures(hsto, float(ra), offset, r, rear, steered)
 
 
+def driver_lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
+                                accel_g: float = LANE_CHANGE[0], f_hz: float = LANE_CHANGE[1],
+                                gain_rad_per_m: float | None = None, preview_s: float | None = None,
+                                model: str = "yaw_plane") -> LaneChangeMeasures:
+    """HSTO and RA in the closed-loop lane change ``driver:A0:F:K:T`` (docs/measures.md): the
+    preview driver steers the tractor along the lane change's path; over 0 <= t <= T + 1/F +
+    8 s, the largest overshoot of the last unit's rearmost axle beyond the path's final offset
+    A0/(2 pi F^2) (0 if none) and max|a_N| / max|a_s|.
+
+    Raises
+    ------
+    ManoeuvreError
+        No steered axle, a closed loop that is unstable, or a steer beyond [-1, 1] rad.
+    """
+    from ..manoeuvres.steer import DRIVER_GAIN_RAD_PER_M, DRIVER_PREVIEW_S, driver_lane_change
+    K = DRIVER_GAIN_RAD_PER_M if gain_rad_per_m is None else float(gain_rad_per_m)
+    T = DRIVER_PREVIEW_S if preview_s is None else float(preview_s)
+    steer = driver_lane_change(accel_g * G_MPS2, f_hz, K, T)
+    t_end = round((T + 1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
+    r = response(vehicle, speed_mps, steer, t_end, DT_S, tire_scale=tire_scale, model=model)
+    offset = lane_change_offset_m(steer)
+    rear = vehicle.units[-1].rearmost_axle.name
+    steered = max(vehicle.steered_axles, key=lambda a: a.x_m).name
+    sign = 1.0 if offset >= 0 else -1.0
+    (_t, Y), (_ta, a_n), (_ts, a_s), (_td, d) = r.extrema_many([f"Y_{rear}", f"ay{vehicle.n_units}", "a_steer",
+                                                                 "delta"])
+    check_lane_change_steer(r, float(np.abs(d).max()))
+    hsto = max(0.0, float(np.max(sign * (Y - offset))))
+    return LaneChangeMeasures(hsto, float(np.abs(a_n).max()) / float(np.abs(a_s).max()), offset, r, rear, steered)
+
+
 @dataclass(frozen=True)
 class SteadyTurn:
     """The steady turn of HSSO (docs/measures.md#high-speed-steady-state-offtracking).
@@ -282,6 +313,19 @@ def lane_change_family(case: MeasureCase) -> tuple[dict, dict]:
     except ManoeuvreError as exc:
         return dict.fromkeys(keys), dict.fromkeys(keys, f"undefined: {exc}")
     return {"hsto_m": lc.hsto_m, "ra_lane_change": lc.ra_lane_change}, {}
+
+
+def driver_lane_change_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``driver_lane_change`` family of one case (null, with the reason, where
+    the closed loop is unstable or the steer leaves its range)."""
+    keys = ("hsto_driver_m", "ra_lane_change_driver")
+    try:
+        lc = driver_lane_change_measures(case.vehicle, case.speed_mps, case.tire_scale,
+                                         case.condition("lane_change_ay_g"), case.condition("lane_change_frequency_hz"),
+                                         case.condition("driver_gain_rad_per_m"), case.condition("driver_preview_s"))
+    except ManoeuvreError as exc:
+        return dict.fromkeys(keys), dict.fromkeys(keys, f"undefined: {exc}")
+    return {"hsto_driver_m": lc.hsto_m, "ra_lane_change_driver": lc.ra_lane_change}, {}
 
 
 def steady_turn_family(case: MeasureCase) -> tuple[dict, dict]:

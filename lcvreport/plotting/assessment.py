@@ -91,7 +91,7 @@ def _lane_change(ev, key: str) -> Figure:
         fig.axes[0].legend(fontsize=SMALL_PT, loc="lower right")
         return fig
     fig = fig_lane_change(lc, _title(ev))
-    if key.startswith("hsto"):
+    if key.startswith("hsto"):                     # hsto_m, hsto_m_roll, hsto_driver_m
         sign = 1.0 if lc.final_offset_m >= 0 else -1.0
         _hlines(fig.axes[1], ev, scale=sign, offset=lc.final_offset_m, what="limit: final offset + HSTO")
         fig.axes[1].legend(fontsize=SMALL_PT, loc="lower right")
