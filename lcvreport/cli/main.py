@@ -10,7 +10,8 @@ Fixed contract (other parts and outside checks call these forms)::
     lcv measures (...) [--load UNITS] --json
     lcv fmu      (--preset NAME | --vehicle FILE) --out DIR [--kind python|native|both] [--fmi 2|3]
     lcv report   (--preset NAME | --vehicle FILE) [--speed-kph V] [--load UNITS] --out DIR
-    lcv study    STUDY.toml --out DIR [--workers N | --scheduler ADDRESS] [--csv] [--report R [--criteria F]]
+    lcv study    STUDY.toml --out DIR [--workers N | --scheduler ADDRESS] [--csv] [--scheme F] [--report R [--criteria F]]
+    lcv assess   (--preset NAME | --vehicle FILE) --scheme SCHEME.toml [--json] [--out DIR]
     lcv presets  [--json]
 
 ``UNITS`` is a comma list of unit names of the vehicle; each gets the 1 % rule on its

@@ -198,8 +198,11 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     reached = next((level for level in scheme.levels if all(m.verdicts[level] == "pass" for m in measures)), None)
     reason = None
     if reached is None:
-        blocking = [f"{m.key}: {m.reason}" for m in measures if m.level_reached is None]
-        reason = "; ".join(blocking) if blocking else "no level is passed by every measure"
+        nc = [m.key for m in measures if m.level_reached is None and "not computed" in m.verdicts.values()]
+        fails = [m.key for m in measures if m.level_reached is None and m.key not in nc]
+        parts = ([f"not computed: {', '.join(nc)}"] if nc else []) + ([f"fails every level: {', '.join(fails)}"]
+                                                                     if fails else [])
+        reason = "; ".join(parts) if parts else "no level is passed by every measure"
     elif reached != scheme.levels[0]:
         first = scheme.levels[0]
         reason = "fails " + first + ": " + ", ".join(m.key for m in measures if m.verdicts[first] != "pass")
