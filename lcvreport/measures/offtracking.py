@@ -77,7 +77,13 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
         No steered axle, an unstable inverse system, or a steer beyond [-1, 1] rad.
     """
     steer = lane_change(accel_g * G_MPS2, f_hz)
-    t_end = round((1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
+    return _lane_change_of(vehicle, speed_mps, steer, 1.0 / f_hz, tire_scale, model)
+
+
+def _lane_change_of(vehicle: Vehicle, speed_mps: float, steer, until_s: float, tire_scale: float,
+                    model: str) -> LaneChangeMeasures:
+    """HSTO and RA of a lane change ``steer`` (open or closed loop) over 0 <= t <= until_s + 8 s."""
+    t_end = round((until_s + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
     r = response(vehicle, speed_mps, steer, t_end, DT_S, tire_scale=tire_scale, model=model)
     offset = lane_change_offset_m(steer)
     rear = vehicle.units[-1].rearmost_axle.name
@@ -109,17 +115,7 @@ def driver_lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: 
     K = DRIVER_GAIN_RAD_PER_M if gain_rad_per_m is None else float(gain_rad_per_m)
     T = DRIVER_PREVIEW_S if preview_s is None else float(preview_s)
     steer = driver_lane_change(accel_g * G_MPS2, f_hz, K, T)
-    t_end = round((T + 1.0 / f_hz + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
-    r = response(vehicle, speed_mps, steer, t_end, DT_S, tire_scale=tire_scale, model=model)
-    offset = lane_change_offset_m(steer)
-    rear = vehicle.units[-1].rearmost_axle.name
-    steered = max(vehicle.steered_axles, key=lambda a: a.x_m).name
-    sign = 1.0 if offset >= 0 else -1.0
-    (_t, Y), (_ta, a_n), (_ts, a_s), (_td, d) = r.extrema_many([f"Y_{rear}", f"ay{vehicle.n_units}", "a_steer",
-                                                                 "delta"])
-    check_lane_change_steer(r, float(np.abs(d).max()))
-    hsto = max(0.0, float(np.max(sign * (Y - offset))))
-    return LaneChangeMeasures(hsto, float(np.abs(a_n).max()) / float(np.abs(a_s).max()), offset, r, rear, steered)
+    return _lane_change_of(vehicle, speed_mps, steer, T + 1.0 / f_hz, tire_scale, model)
 
 
 @dataclass(frozen=True)
