@@ -13,7 +13,7 @@ Examples
 >>> from lcvreport.units import kph_to_mps
 >>> m = measure_set(load_preset("aucnat"), kph_to_mps(88.0), load_units=["trailer2", "trailer3"])
 >>> sorted(m.to_dict())[:5]
-['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m', 'hsto_m']
+['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m', 'hsto_driver_m']
 """
 from __future__ import annotations
 
