@@ -76,7 +76,8 @@ class MeasureCase:
         if key == "ra_frequency_hz":
             return self.f_hz
         if key == "speed_kph":
-            return self.speed_mps * 3.6
+            from ..units import mps_to_kph
+            return mps_to_kph(self.speed_mps)
         value = self.conditions.get(key)
         return CONDITIONS[key].default if value is None else float(value)
 
@@ -199,7 +200,8 @@ class Condition:
     def check(self, value, name: str | None = None) -> float:
         """``value`` as a float, or :class:`lcvreport.ranges.RangeError` naming ``name``."""
         from ..ranges import RANGES
-        factor = 3.6 if self.key == "speed_kph" else 1.0
+        from ..units import MPS_PER_KPH
+        factor = 1.0 / MPS_PER_KPH if self.key == "speed_kph" else 1.0
         return RANGES[self.range].check(value, name or self.key, factor=factor, unit=self.unit)
 
 

@@ -59,7 +59,7 @@ def fig_evidence(ev) -> Figure:
     if ev.kind == "swept_path":
         from .low_speed import fig_swept_path
         fig = fig_swept_path(ev.result, _title(ev))
-        _text_box(fig.axes[0], ev)
+        _text_box(fig.axes[0], ev, x=0.55)                  # the drawing's legend holds the upper left
         return fig
     if ev.kind == "tilt":
         from .roll import plot_rollover
@@ -73,9 +73,10 @@ def fig_evidence(ev) -> Figure:
     return _value(ev)
 
 
-def _text_box(ax, ev) -> None:
+def _text_box(ax, ev, x: float = 0.01) -> None:
+    """The limits and verdicts of every level in a box at the top of ``ax`` (from ``x``, axes fraction)."""
     lines = [f"{level}: {ev.verdict.limits[level]}: {ev.verdict.verdicts[level]}" for level in ev.levels]
-    ax.text(0.01, 0.99, "\n".join(lines), transform=ax.transAxes, fontsize=SMALL_PT, va="top", ha="left",
+    ax.text(x, 0.99, "\n".join(lines), transform=ax.transAxes, fontsize=SMALL_PT, va="top", ha="left",
             bbox={"facecolor": "white", "edgecolor": "gray", "lw": 0.5, "alpha": 0.9}, zorder=10)
 
 
