@@ -235,3 +235,15 @@ def steady_turn_newton_euler(vehicle: Vehicle, speed_mps: float, yaw_rate: float
         row += 1
     sol = np.linalg.solve(A, rhs)
     return sol[iv:iv + nv], float(sol[idl])
+
+
+#: the child's SIGINT at its default, as in a terminal: a runner started in the background (``cmd &``
+#: in a script) passes SIGINT ignored to its children, and Python then installs no Ctrl-C handler
+_DEFAULT_SIGINT = "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); os.execv(sys.argv[1], sys.argv[1:])"
+
+
+def with_default_sigint(cmd: list) -> list:
+    """``cmd`` run with SIGINT at its default disposition whatever this process inherited (the
+    Ctrl-C tests test what a user at a terminal gets)."""
+    import sys
+    return [sys.executable, "-c", _DEFAULT_SIGINT, *[str(c) for c in cmd]]

@@ -26,6 +26,7 @@ from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
 from lcvreport.model.yaw_plane.outputs import rear_offsets
 from lcvreport.ranges import RANGES
 from lcvreport.units import THESIS
+from helpers import with_default_sigint
 
 MPS_PER_MPH = 0.44704       # typed here on purpose
 WESTERN = str(EXAMPLES / "western_double.toml")
@@ -372,8 +373,9 @@ def test_ctrl_c_is_one_line_and_status_130(tmp_path):
     exe = shutil.which("lcv", path=os.path.dirname(sys.executable))
     out = tmp_path / "run.csv"
     with open(out, "w") as f:
-        proc = subprocess.Popen([exe, "simulate", "--preset", "aucnat", "--speed-kph", "88", "--load", "trailer3",
-                                 "--t-end", "5000", "--dt", "0.001"], stdout=f, stderr=subprocess.PIPE, text=True)
+        proc = subprocess.Popen(with_default_sigint([exe, "simulate", "--preset", "aucnat", "--speed-kph", "88",
+                                                     "--load", "trailer3", "--t-end", "5000", "--dt", "0.001"]),
+                                stdout=f, stderr=subprocess.PIPE, text=True)
         time.sleep(3.0)
         proc.send_signal(signal.SIGINT)
         _out, err = proc.communicate(timeout=60)

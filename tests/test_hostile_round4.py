@@ -21,6 +21,7 @@ import pytest
 from lcvreport.study.run import run_study
 from lcvreport.study.results import read_study
 from lcvreport.study.spec import StudyError, study_from_dict
+from helpers import with_default_sigint
 
 ROOT = Path(__file__).resolve().parents[1]
 LCV = [sys.executable, "-m", "lcvreport.cli"]
@@ -440,7 +441,8 @@ def test_ctrl_c_on_a_study_with_workers_prints_one_line(tmp_path, after_chunks):
                     '[design]\nkind = "random"\ncount = 100000\nseed = 1\n[factors]\n'
                     '"trailer1.mass_scale" = {distribution = "uniform", low = 0.8, high = 1.2}\n')
     out = tmp_path / "out"
-    proc = subprocess.Popen(LCV + ["study", str(path), "--out", str(out), "--workers", "2"], stdout=subprocess.PIPE,
+    proc = subprocess.Popen(with_default_sigint(LCV + ["study", str(path), "--out", str(out), "--workers", "2"]),
+                            stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, start_new_session=True)
     deadline = time.time() + HANG_S
     while time.time() < deadline and proc.poll() is None and \

@@ -29,6 +29,7 @@ from lcvreport.model.vehicle_file import load_vehicle
 from lcvreport.report.notebooks import NOTEBOOKS, SPECS, ReportError, execute, overfull_boxes
 
 from conftest import EXAMPLES, ROOT
+from helpers import with_default_sigint
 
 FIGURES = (["1-2", "2-1", "2-2", "2-5", "2-6", "2-8", "2-10"] + [f"3-{i}" for i in range(1, 14)]
            + [f"4-{i}" for i in range(1, 17)] + [f"5-{i}" for i in range(1, 22)] + ["D.1", "D.2", "D.3"])
@@ -475,8 +476,8 @@ def _interrupted_report(tmp_path, delay_s: float, sig, group: bool = True):
     import os
     import time
     out = tmp_path / "r"
-    proc = subprocess.Popen([sys.executable, "-m", "lcvreport.cli", "report", "--preset", "tractor_semitrailer",
-                             "--no-pdf", "--out", str(out)],
+    proc = subprocess.Popen(with_default_sigint([sys.executable, "-m", "lcvreport.cli", "report", "--preset",
+                                                 "tractor_semitrailer", "--no-pdf", "--out", str(out)]),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     deadline = time.time() + 120                     # a hang guard: the staging folder appears in ~1 s
     while not list(tmp_path.glob(".r.writing-*")) and time.time() < deadline and proc.poll() is None:

@@ -19,6 +19,7 @@ import pytest
 from lcvreport import load_preset, measure_set, read_study, study_case
 from lcvreport.study.run import run_study
 from lcvreport.study.spec import BATCHED, MEASURES, StudyError, load_study, study_from_dict
+from helpers import with_default_sigint
 
 ROOT = Path(__file__).resolve().parents[1]
 LCV = [sys.executable, "-m", "lcvreport.cli"]
@@ -150,7 +151,8 @@ def test_an_interrupted_study_loses_no_finished_chunk_and_the_rerun_completes_it
     path = _write(tmp_path, doc)
     out = tmp_path / "out"
     cmd = LCV + ["study", str(path), "--out", str(out)] + (["--workers", str(workers)] if workers else [])
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    p = subprocess.Popen(with_default_sigint(cmd), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         cwd=tmp_path)
     chunks = out / "chunks"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline:
