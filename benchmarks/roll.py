@@ -5,7 +5,9 @@ The 6-unit vehicle is the AU-NCAT triple with the examples' assumed roll data
 (``examples/vehicles/make_examples.py``: ROLL_UNITS, ROLL_AXLES), written to a temporary file.
 The comparison is the same vehicle without its roll keys (the roll families then return at
 once): what the roll families add to ``measure_set``.  Best of ``REPEATS``; one BLAS thread.
-Targets (issue 31): ``lcv roll`` <= 0.5 s with start-up; the roll measure set <= 3x the yaw-plane one.
+Targets (issue 31): ``lcv roll`` <= 0.5 s with start-up; the roll measure set <= 3x the yaw-plane one;
+the native yaw-roll FMU's step <= 2x the yaw-plane one (the 6-unit vehicle's FMUs of both models
+in the plain C host of ``tests/c_host.c``, 10^6 steps of 1 ms with a residual force on the rear axle).
 
     python benchmarks/roll.py
 """
@@ -88,6 +90,33 @@ def main() -> None:
     t_r, t_y = best(lambda: families(roll, v)), best(lambda: families(yaw, v))
     print(f"the roll families alone {t_r * 1e3:.1f} ms, the yaw-plane families but the turn {t_y * 1e3:.1f} ms: "
           f"ratio {t_r / t_y:.2f}")
+    plane_us, roll_us = native_step_us(v, "yaw_plane"), native_step_us(v, "yaw_roll")
+    print(f"native FMU step in the C host, 6 units: yaw-plane {plane_us:.3f} us, yaw-roll {roll_us:.3f} us: ratio "
+          f"{roll_us / plane_us:.2f} (target <= 2)")
+
+
+def native_step_us(vehicle, model: str) -> float:
+    """Per-step time [us] of the vehicle's native FMU of ``model`` in tests/c_host.c (best of REPEATS)."""
+    import xml.etree.ElementTree as ET
+    import zipfile
+    from lcvreport.fmu.build import build_vehicle_fmus
+    with tempfile.TemporaryDirectory() as tmp:
+        fmu = build_vehicle_fmus(vehicle, tmp, kind="native", model=model)[0]
+        exe = Path(tmp) / "c_host"
+        subprocess.run(["gcc", "-O2", "-std=c99", "-o", str(exe), str(ROOT / "tests" / "c_host.c"), "-ldl"],
+                       check=True)
+        unzipped = Path(tmp) / "fmu"
+        zipfile.ZipFile(fmu).extractall(unzipped)
+        root = ET.parse(unzipped / "modelDescription.xml").getroot()
+        vr = {sv.get("name"): sv.get("valueReference") for sv in root.iter("ScalarVariable")}
+        rear = f"P_{vehicle.axles[-1].name}"
+        out = float("inf")
+        for _ in range(REPEATS):
+            p = subprocess.run([str(exe), str(unzipped), f"{vehicle.name}Native", root.get("guid"), "bench",
+                                str(int(1e6)), "0.001", vr[rear], vr["Y_rear"]], check=True, capture_output=True,
+                               text=True)
+            out = min(out, *(float(x.split()[1]) for x in p.stdout.splitlines() if x.startswith("us_per_step")))
+        return out
 
 
 if __name__ == "__main__":

@@ -2,6 +2,8 @@
 and the package's own exact response to a schedule of FMU inputs (the reference)."""
 from __future__ import annotations
 
+import dataclasses
+
 from pathlib import Path
 
 import numpy as np
@@ -89,8 +91,7 @@ def reference_outputs(itf, steps, preset=None, tire_scale: float = 1.0, u_min: f
         for k in arrays:
             arrays[k] *= 1 + delta * rng.choice([-1.0, 1.0], arrays[k].shape)
         Bw *= 1 + delta * rng.choice([-1.0, 1.0], Bw.shape)
-    pco = type(co)(co.vehicle, co.units, **arrays, Bdelta=co.Bdelta, B_P=co.B_P, B_T=co.B_T, Jv=co.Jv, Jr=co.Jr,
-                   K=co.K)
+    pco = dataclasses.replace(co, **arrays)            # either model: its other fields as they are
     cache = {}
     z = np.zeros(co.n_states + 2)
     rows = []

@@ -118,7 +118,7 @@ static SpeedEntry *speed_entry(ModelInstance *c, double u)
         else if (e->stamp < oldest->stamp) oldest = e;
     }
     if (!slot) slot = oldest;
-    int n = v->n, N = v->n_units;
+    int n = v->n;
     /* work: M (n n) | S, then [S | I] solved in place: n x 2n | solve workspace n n + n */
     double *M = c->work, *SI = M + (size_t)n * n, *ws = SI + 2 * (size_t)n * n;
     double *S = ws;   /* S is assembled in the solve workspace first, then copied */
@@ -132,19 +132,23 @@ static SpeedEntry *speed_entry(ModelInstance *c, double u)
     if (lcv_solve_scaled(M, n, SI, 2 * n, 2 * n, ws) != 0) return NULL;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) slot->A[(size_t)i * n + j] = SI[(size_t)i * 2 * n + j];
-    /* V = Vq + u Vth; Ca = V A + u R; Da = V M^-1; DaB = Da Bw */
-    double *V = ws, *Da = V + (size_t)N * n;
-    for (int i = 0; i < N * n; ++i) V[i] = v->Vq[i] + u * v->Vth[i];
-    lcv_matmul(V, n, slot->A, n, slot->Ca, n, N, n, n);
-    for (int i = 0; i < N * n; ++i) slot->Ca[i] += u * v->R[i];
-    for (int i = 0; i < N; ++i)
+    /* XD = FD0 + u FD1; Ca = XD A + X; Da = XD M^-1; DaB = Da Bw + FW0 + s FW1 (ay: XD = V, X = u R) */
+    int nf = v->n_fd, ni = LCV_N_INPUTS;
+    double scale = c->s.tire_scale;
+    double *V = ws, *Da = V + (size_t)nf * n;
+    for (int i = 0; i < nf * n; ++i) V[i] = v->FD0[i] + u * v->FD1[i];
+    lcv_matmul(V, n, slot->A, n, slot->Ca, n, nf, n, n);
+    for (int i = 0; i < nf * n; ++i)
+        slot->Ca[i] += v->FX0[i] + u * v->FX1[i] + scale / u * v->FX2[i] + scale * v->FX3[i];
+    for (int i = 0; i < nf; ++i)
         for (int j = 0; j < n; ++j) {
             double s = 0.0;
             for (int l = 0; l < n; ++l) s += V[(size_t)i * n + l] * SI[(size_t)l * 2 * n + n + j];
             Da[(size_t)i * n + j] = s;
         }
-    lcv_matmul(Da, n, c->Bw, LCV_N_INPUTS, slot->DaB, LCV_N_INPUTS, N, n, LCV_N_INPUTS);
-    for (int i = 0; i < N; ++i) {
+    lcv_matmul(Da, n, c->Bw, ni, slot->DaB, ni, nf, n, ni);
+    for (int i = 0; i < nf * ni; ++i) slot->DaB[i] += v->FW0[i] + scale * v->FW1[i];
+    for (int i = 0; i < nf; ++i) {
         double s = 0.0;
         for (int l = 0; l < n; ++l) s += Da[(size_t)i * n + l] * c->Fc[l];
         slot->daF[i] = s;
@@ -514,7 +518,8 @@ int model_directional(ModelInstance *c, const unsigned unknowns[], size_t nu, co
         case LCV_OUT_LINEAR:
             for (int j = 0; j < m; ++j) s += v->C[(size_t)o * m + j] * dz[j];
             break;
-        case LCV_OUT_LATERAL:                           /* y = W sin(H z): dy = W cos(H z) H dz */
+        case LCV_OUT_LATERAL:                           /* y = C z + W sin(H z): dy = C dz + W cos(H z) H dz */
+            for (int j = 0; j < m; ++j) s += v->C[(size_t)o * m + j] * dz[j];
             for (int k = 0; k < N - 1; ++k) {
                 double hz = 0.0, hd = 0.0;
                 for (int j = 0; j < m; ++j) { hz += v->H[(size_t)k * m + j] * c->s.z[j]; hd += v->H[(size_t)k * m + j] * dz[j]; }
@@ -522,7 +527,7 @@ int model_directional(ModelInstance *c, const unsigned unknowns[], size_t nu, co
             }
             break;
         case LCV_OUT_ACCEL: {
-            int iu = v->ay_unit[o];
+            int iu = v->fd_row[o];
             if (iu < 0) break;
             for (int j = 0; j < n; ++j) s += se->Ca[(size_t)iu * n + j] * dz[j];
             for (int j = 0; j < LCV_N_INPUTS; ++j) s += se->DaB[(size_t)iu * LCV_N_INPUTS + j] * dw[j];
@@ -546,33 +551,39 @@ static double output_speed(const ModelInstance *c)
     return c->s.last_speed;
 }
 
-/* every output into out[]; valid[o] = 0 where an output cannot be evaluated (c->msg says why) */
-static void compute_outputs(ModelInstance *c, double *out, int *valid)
+/* the outputs o with want[o] into out[]; valid[o] = 0 where one cannot be evaluated (c->msg says
+   why); only what a host asks for is computed (a host reading one output pays for one) */
+static void compute_outputs(ModelInstance *c, const char *want, double *out, int *valid)
 {
     const LcvVehicle *v = vehicle_of(c);
     int n = v->n, m = n + 2, N = v->n_units;
     char why[1024] = "";
-    int inputs_ok = -1;
+    int inputs_ok = -1, have_sin = 0;
     double theta_sin[LCV_MAX_UNITS] = {0};        /* a single unit has none (and gcc must see it set) */
-    for (int k = 0; k < N - 1; ++k) {
-        double s = 0.0;
-        for (int j = 0; j < m; ++j) s += v->H[(size_t)k * m + j] * c->s.z[j];
-        theta_sin[k] = sin(s);
-    }
     double u = output_speed(c);
     SpeedEntry *se = NULL;
     for (int o = 0; o < LCV_N_OUTPUTS; ++o) {
         double s = 0.0;
         valid[o] = 1;
+        if (!want[o]) { out[o] = 0.0; continue; }
+        if (LCV_OUTPUT_KIND[o] == LCV_OUT_LATERAL && !have_sin) {
+            for (int k = 0; k < N - 1; ++k) {
+                double hz = 0.0;
+                for (int j = 0; j < m; ++j) hz += v->H[(size_t)k * m + j] * c->s.z[j];
+                theta_sin[k] = sin(hz);
+            }
+            have_sin = 1;
+        }
         switch (LCV_OUTPUT_KIND[o]) {
         case LCV_OUT_LINEAR:
             for (int j = 0; j < m; ++j) s += v->C[(size_t)o * m + j] * c->s.z[j];
             break;
-        case LCV_OUT_LATERAL:
+        case LCV_OUT_LATERAL:                           /* y = C z + W sin(H z) (C: the yaw-roll model's roll offsets) */
+            for (int j = 0; j < m; ++j) s += v->C[(size_t)o * m + j] * c->s.z[j];
             for (int k = 0; k < N - 1; ++k) s += v->W[(size_t)o * (N - 1) + k] * theta_sin[k];
             break;
         case LCV_OUT_ACCEL: {
-            int i = v->ay_unit[o];
+            int i = v->fd_row[o];
             if (i < 0) break;
             if (inputs_ok < 0) {
                 inputs_ok = check_inputs_(c, 0) == 0;
@@ -609,7 +620,11 @@ int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, 
 {
     double out[LCV_N_OUTPUTS];
     int valid[LCV_N_OUTPUTS];
+    char want[LCV_N_OUTPUTS];
     int have = 0, status = 0;
+    memset(want, 0, sizeof want);
+    for (size_t i = 0; i < nvr; ++i)
+        if (vr[i] >= LCV_FIRST_OUTPUT && vr[i] < LCV_FIRST_OUTPUT + LCV_N_OUTPUTS) want[vr[i] - LCV_FIRST_OUTPUT] = 1;
     for (size_t i = 0; i < nvr; ++i) {
         unsigned r = vr[i];
         switch (r) {
@@ -631,7 +646,7 @@ int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, 
             value[i] = 0.0;
             if (c->s.vehicle < 0) continue;                /* before initialization: at rest */
             if (!have) {
-                compute_outputs(c, out, valid);
+                compute_outputs(c, want, out, valid);
                 have = 1;
             }
             value[i] = out[r - LCV_FIRST_OUTPUT];

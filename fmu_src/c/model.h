@@ -42,9 +42,9 @@ typedef struct {
     double u;
     unsigned long stamp;
     double A[LCV_MAX_STATES * LCV_MAX_STATES];          /* M^-1 S */
-    double Ca[LCV_MAX_UNITS * LCV_MAX_STATES];          /* a = Ca x + DaB w */
-    double DaB[LCV_MAX_UNITS * LCV_N_INPUTS];
-    double daF[LCV_MAX_UNITS];                          /* Da Fc: the crossfall's lateral accelerations */
+    double Ca[LCV_MAX_FD * LCV_MAX_STATES];             /* feedthrough rows (ay, extras): Ca x + DaB w + daF */
+    double DaB[LCV_MAX_FD * LCV_N_INPUTS];
+    double daF[LCV_MAX_FD];                             /* the crossfall's part */
     int eig_state;                                      /* 0 not computed, 1 ok, -1 failed */
     double eig;                                         /* max real part [1/s] */
 } SpeedEntry;

@@ -15,9 +15,15 @@ from .output import OutputError, _Out
 def _cmd_fmu(args, out: _Out) -> int:
     from ..fmu.build import build_vehicle_fmus
     from ..fmu.c_sources import FmuBuildError
-    v = _vehicle(args)
+    from ..model.linear import check_model
+    model = check_model(args.model)
+    if model == "yaw_roll":
+        from .roll import roll_vehicle
+        v = roll_vehicle(args)                  # the roll keys, checked: one line naming what is missing
+    else:
+        v = _vehicle(args)
     try:
-        kw = {}
+        kw = {"model": model}
         if args.speed_kph is not None or args.speed_mph is not None:
             kw["u_start_mps"] = _speed_mps(args)      # the start value of the input u
         kind = args.kind or "both"

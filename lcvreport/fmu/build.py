@@ -123,7 +123,7 @@ def _pythonfmu_build(tool: str, itf: Interface, tmp: Path, alias: str, script: s
     (proj / script).write_text(script_text, encoding="utf-8")
     cfg = {"mode": "presets"} if itf.preset_mode else {
         "mode": "vehicle", "vehicle_file": "vehicle.toml",
-        "u_start_mps": next(v.start for v in itf.variables if v.name == "u")}
+        "u_start_mps": next(v.start for v in itf.variables if v.name == "u"), "model": itf.model}
     (proj / "lcv_fmu.json").write_text(json.dumps(cfg), encoding="utf-8")
     extra = [proj / "lcv_fmu.json"]
     if not itf.preset_mode:
@@ -263,7 +263,7 @@ def fmi3_python_name(name: str) -> str:
 
 
 def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both",
-                       u_start_mps: float = U_START, fmi: int = 2) -> list[Path]:
+                       u_start_mps: float = U_START, fmi: int = 2, model: str = "yaw_plane") -> list[Path]:
     """``<name>.fmu`` (pythonfmu) and/or ``<name>Native.fmu`` (C99) of a vehicle (docs/fmu.md);
     with ``fmi=3``, ``<name>3.fmu`` (pythonfmu3; ``<name>_fmi3.fmu`` when the name ends in a digit)
     and/or ``<name>Native3.fmu`` (docs/fmu.md).
@@ -276,12 +276,15 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
     u_start_mps : float
         Start value of the input ``u`` [m/s] (default 50 mph).
     fmi : {2, 3}
+    model : {"yaw_plane", "yaw_roll"}
+        The linear model built in (:func:`~lcvreport.fmu.interface.vehicle_interface`); the
+        file names are the same for both.
     """
     if kind not in ("python", "native", "both"):
         raise ValueError(f"kind must be python, native or both, got {kind!r}")
     if fmi not in (2, 3):
         raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
-    itf = vehicle_interface(vehicle, u_start_mps)
+    itf = vehicle_interface(vehicle, u_start_mps, model)
     out = []
     if fmi == 3:
         if kind in ("python", "both"):

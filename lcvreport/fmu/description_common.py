@@ -48,6 +48,11 @@ LOG_CATEGORIES = {
 DEFAULT_EXPERIMENT = {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.001"}
 
 
+#: outputs that depend on the inputs directly: the lateral accelerations and the yaw-roll model's
+#: sprung accelerations, load transfers and LTRs
+FEEDTHROUGH = ("ay", "extra")
+
+
 def _state_dependencies(itf: Interface) -> dict:
     """Output name -> the continuous states it depends on (Model Exchange), from the engine's
     output maps of every vehicle of the FMU: linear outputs through C, rear offsets through
@@ -61,10 +66,11 @@ def _state_dependencies(itf: Interface) -> dict:
         heading_z = {j for j in range(maps["H"].shape[1]) if np.any(maps["H"][:, j] != 0)}
         for o, v in enumerate(itf.outputs):
             kind = v.source[0]
-            if kind == "ay":
-                deps[v.name] |= {name for j, name in z_of.items() if j < linear_model(vehicle).n_states}
+            if kind in FEEDTHROUGH:
+                deps[v.name] |= {name for j, name in z_of.items() if j < linear_model(vehicle, itf.model).n_states}
             elif kind == "y":
                 deps[v.name] |= {z_of[j] for j in heading_z if j in z_of and np.any(maps["W"][o] != 0)}
+                deps[v.name] |= {z_of[j] for j in np.nonzero(maps["C"][o])[0] if j in z_of}   # roll offsets
             elif kind != "max_real_eig":
                 deps[v.name] |= {z_of[j] for j in np.nonzero(maps["C"][o])[0] if j in z_of}
     return deps
@@ -141,7 +147,7 @@ def _direct_dependencies(itf: Interface, v: FmuVariable, states: dict | None = N
     """Inputs (feedthrough) and, with ``states``, continuous states an output depends on."""
     kind = v.source[0]
     out = set((states or {}).get(v.name, ()))
-    if kind == "ay":
+    if kind in FEEDTHROUGH:
         out |= {w.name for w in itf.inputs}
     if kind == "max_real_eig":
         out |= {"u"}
@@ -152,7 +158,7 @@ def _initial_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
     """Inputs and parameters an output depends on at initialization."""
     kind = v.source[0]
     params = [p.name for p in itf.parameters]
-    if kind == "ay":
+    if kind in FEEDTHROUGH:
         return [w.name for w in itf.inputs] + params
     if kind == "max_real_eig":
         return ["u"] + params

@@ -16,8 +16,12 @@ Semantics (both FMUs):
   (:class:`CosimError`, the state is kept);
 * a step whose result is not finite is refused with the state kept;
 * outputs: the state's linear functions, the rear offsets (eq. 4.42-4.46, with the
-  sine), ``ay_i`` at the current state and inputs, ``max_real_eig`` at the current
-  (clamped) input speed; units a preset lacks give 0.
+  sine), the feedthrough outputs at the current state and inputs (``ay_i``; the yaw-roll
+  model's ``as_i``, ``dFz_<axle>``, ``ltr<g>``), ``max_real_eig`` at the current (clamped)
+  input speed; units a preset lacks give 0.
+
+The model is the interface's (:attr:`Interface.model`): the yaw plane or the yaw-roll model,
+whose state ``x`` adds the roll rates and roll angles.
 
 Examples
 --------
@@ -37,8 +41,7 @@ import numpy as np
 
 from ..analysis.discretize import augmented_state_matrix
 from ..model.linear import linear_model
-from ..model.yaw_plane.equations import system_coefficients
-from ..model.yaw_plane.outputs import point_lateral_map, rear_end_weights
+from ..model.yaw_plane.outputs import rear_end_weights
 from ..ranges import RANGES, RangeError
 from ..util.cache import LRUCache
 from ..util.numerics import expm
@@ -99,10 +102,10 @@ class LCVEngine:
         self.tire_scale = float(tire_scale)
         self.u_min = float(u_min)
         self.crossfall = float(crossfall)
-        self.co = system_coefficients(vehicle)
+        self.co = linear_model(vehicle, interface.model)
         # the crossfall's constant generalized force: one more input column, always 1
         self._Fc = math.sin(math.atan(self.crossfall / 100.0)) * self.co.B_crossfall
-        self.n = linear_model(vehicle).n_states
+        self.n = self.co.n_states
         self.m = self.n + 2
         self.input_names = tuple(v.name for v in interface.inputs)
         self.input_index = {name: k for k, name in enumerate(self.input_names)}
@@ -141,23 +144,26 @@ class LCVEngine:
                 self._ranges.append(RANGES[_INPUT_RANGE[kind]])
             else:
                 self._ranges.append(None)
+        # each axle's constant tire force from the inputs (the load transfer's F_y0): P + s C_F eps
+        self._Fy_w = np.zeros((len(axles), len(self.input_names)))
+        for k, var in enumerate(self.interface.inputs):
+            if var.source[0] in ("P", "eps") and var.source[1] in axles:
+                j = axles.index(var.source[1])
+                self._Fy_w[j, k] = 1.0 if var.source[0] == "P" else \
+                    self.tire_scale * v.axles[j].cornering_stiffness_axle_N_per_rad
         self._range_lo = np.array([-np.inf if r is None else r.low for r in self._ranges])
         self._range_hi = np.array([np.inf if r is None else r.high for r in self._ranges])
         n_out = len(self.output_names)
         self._C = np.zeros((n_out, m))           # linear outputs of z
         self._W = np.zeros((n_out, nu - 1))      # y outputs: W sin(Theta)
-        self._ay_unit = np.full(n_out, -1)       # unit index of ay outputs
+        self._fd_row = np.full(n_out, -1)        # row of a feedthrough output: ay_1..ay_N, then the extras
         self._eig_out = -1
-        cum = np.zeros((nu - 1, m))              # Theta = cum z
-        for k in range(nu - 1):
-            cum[k, nu + 1:nu + 2 + k] = 1.0
-        self._H = cum
+        self._H = co.heading_rows()              # Theta = H z
         W_all = rear_end_weights(v)
-        c = point_lateral_map(v, nu - 1, v.rear_end_x_m(nu - 1))     # Y_rear = c . [psi1, Y1, Theta]
-        rear_row = c[2:] @ cum
-        rear_row[n] += c[0]
-        rear_row[n + 1] += c[1]
-        states = linear_model(v).state_names
+        rear_row = co.point_lateral_row(nu - 1, v.rear_end_x_m(nu - 1))
+        roll_rows = co.roll_offset_rows()        # the yaw-roll model's roll offsets of units 2..N
+        extra_names = co.extra_signal_terms()["names"]
+        states = co.state_names
         for o, var in enumerate(self.interface.outputs):
             kind = var.source[0]
             if kind == "state" and var.source[1] in states:
@@ -168,35 +174,38 @@ class LCVEngine:
                 self._C[o, n + 1] = 1.0
             elif kind == "Y_rear":
                 self._C[o] = rear_row
-            elif kind == "Y_axle":                            # an axle centre: c . [psi1, Y1, Theta]
-                i = v.axle_units[v.axle_names.index(var.source[1])]
-                ca = point_lateral_map(v, i, v.axles[v.axle_names.index(var.source[1])].x_m)
-                row = ca[2:] @ cum
-                row[n] += ca[0]
-                row[n + 1] += ca[1]
-                self._C[o] = row
+            elif kind == "Y_axle":                            # an axle centre
+                j = v.axle_names.index(var.source[1])
+                self._C[o] = co.point_lateral_row(v.axle_units[j], v.axles[j].x_m)
             elif kind == "y" and var.source[1] <= nu:
                 self._W[o] = W_all[var.source[1] - 2]
+                if roll_rows is not None:
+                    self._C[o, :n] = roll_rows[var.source[1] - 2]
             elif kind == "ay" and var.source[1] <= nu:
-                self._ay_unit[o] = var.source[1] - 1
+                self._fd_row[o] = var.source[1] - 1
+            elif kind == "extra":
+                self._fd_row[o] = nu + extra_names.index(var.source[1])
             elif kind == "max_real_eig":
                 self._eig_out = o
         self._has_y = bool(np.any(self._W))
 
     def maps(self) -> dict:
         """The engine's input and output maps (what the C FMU's generated data holds):
-        ``Bw`` (2N x inputs, steer and misalignment columns at tire scale 1), ``C`` (outputs x 2N+2),
-        ``H`` (N-1 x 2N+2), ``W`` (outputs x N-1), ``ay_unit`` (outputs; -1: not an ay),
+        ``Bw`` (n x inputs, steer and misalignment columns at tire scale 1), ``C`` (outputs x n+2),
+        ``H`` (N-1 x n+2), ``W`` (outputs x N-1), ``fd_row`` (outputs: the feedthrough row
+        -- ``ay_i`` is row i-1, the model's extra signals follow --, -1: not one), ``Fy_w``
+        (axles x inputs: each axle's constant tire force, misalignment columns at tire scale 1),
         ``eig_out`` (index of max_real_eig or -1)."""
-        Bw = self._Bw.copy()
+        Bw, Fy_w = self._Bw.copy(), self._Fy_w.copy()
         if self.tire_scale != 1.0:
             for k, var in enumerate(self.interface.inputs):
                 if var.source[0] == "steer":
                     Bw[:, k] = self.co.B_delta(1.0)
                 elif var.source[0] == "eps":
                     Bw[:, k] /= self.tire_scale
+                    Fy_w[:, k] /= self.tire_scale
         return {"Bw": Bw, "C": self._C.copy(), "H": self._H.copy(), "W": self._W.copy(),
-                "ay_unit": self._ay_unit.copy(), "eig_out": self._eig_out}
+                "fd_row": self._fd_row.copy(), "Fy_w": Fy_w, "eig_out": self._eig_out}
 
     def start_inputs(self) -> np.ndarray:
         """The inputs' start values (interface order), SI."""
@@ -275,10 +284,20 @@ class LCVEngine:
         return self._steps_out.get((u, h), compute)
 
     def _speed_maps(self, u: float) -> dict:
-        """Output maps that depend on the speed: ay (Ca, Da Bw); max_real_eig (lazy)."""
+        """Output maps that depend on the speed: the feedthrough rows ``fd = Ca x + DaB w + daF``
+        (ay, then the model's extra signals ``X x + XD x' + D delta + O F_y0``); max_real_eig (lazy)."""
         def compute():
-            Ca, Da = self.co.acceleration_maps(u, self.tire_scale)
-            return {"Ca": Ca, "DaB": Da @ self._Bw, "daF": Da @ self._Fc, "eig": None}
+            co, s = self.co, self.tire_scale
+            Ca, Da = co.acceleration_maps(u, s)
+            DaB, daF = Da @ self._Bw, Da @ self._Fc
+            names, X, XD, D, O = co.extra_signals(u, s)
+            if names:
+                A, G = co.state_derivative_maps(u, s)
+                steer = np.array([var.source[0] == "steer" for var in self.interface.inputs], dtype=float)
+                Ca = np.vstack([Ca, X + XD @ A])
+                DaB = np.vstack([DaB, XD @ G @ self._Bw + np.outer(D, steer) + O @ self._Fy_w])
+                daF = np.r_[daF, XD @ G @ self._Fc]
+            return {"Ca": Ca, "DaB": DaB, "daF": daF, "eig": None}
         return self._speeds.get(u, compute)
 
     def max_real_eig(self, u: float) -> float:
@@ -391,11 +410,11 @@ class LCVEngine:
         O = maps.get("O")
         if O is None:
             O = np.hstack([self._C, np.zeros((self._C.shape[0], len(self.input_names) + 1))])
-            sel = np.flatnonzero(self._ay_unit >= 0)
+            sel = np.flatnonzero(self._fd_row >= 0)
             if sel.size:
-                O[sel, :self.n] = maps["Ca"][self._ay_unit[sel]]
-                O[sel, self.m:-1] = maps["DaB"][self._ay_unit[sel]]
-                O[sel, -1] = maps["daF"][self._ay_unit[sel]]
+                O[sel, :self.n] = maps["Ca"][self._fd_row[sel]]
+                O[sel, self.m:-1] = maps["DaB"][self._fd_row[sel]]
+                O[sel, -1] = maps["daF"][self._fd_row[sel]]
             O.setflags(write=False)
             maps["O"] = O
         return O
@@ -416,7 +435,7 @@ class LCVEngine:
             out = self.output_matrix(u) @ self.stacked(w)
         else:
             out = self._C @ self.z
-            sel = self._ay_unit >= 0
+            sel = self._fd_row >= 0
             out[sel] = np.nan
             self.output_error = (f"the lateral accelerations depend on the inputs and {problem.variable} is "
                                  f"not valid: {problem}")

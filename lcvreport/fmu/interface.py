@@ -131,6 +131,9 @@ class Interface:
     preset_mode : bool
         True for the preset FMUs' interface (a ``preset`` parameter; docs/fmu.md).
     description : str
+    model : str
+        The linear model the FMU runs (:data:`lcvreport.model.linear.MODELS`): ``yaw_plane``, or
+        ``yaw_roll`` with the roll states and outputs (docs/fmu.md).
     """
 
     model_name: str
@@ -138,6 +141,7 @@ class Interface:
     vehicles: tuple[Vehicle, ...]
     preset_mode: bool
     description: str = ""
+    model: str = "yaw_plane"
     by_name: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -164,7 +168,7 @@ class Interface:
     @property
     def continuous_states(self) -> tuple[FmuVariable, ...]:
         """The Model Exchange states: the outputs v1, r1..rN, the articulation angles, psi1, Y1
-        (docs/fmu.md), in value-reference order."""
+        (and the yaw-roll model's p1..pN, phi1..phiN; docs/fmu.md), in value-reference order."""
         return tuple(v for v in self.outputs if v.source[0] in ("state", "psi1", "Y1"))
 
     def state_nominals(self) -> tuple[float, ...]:
@@ -177,19 +181,21 @@ class Interface:
         Computed at build time (the FMU's runtime does not compute it)."""
         from ..analysis.exact import response
         from ..manoeuvres.steer import sine, step
-        from ..model.yaw_plane.equations import system_coefficients
         u = float(self.by_name["u"].start)
         peaks = np.zeros(len(self.continuous_states))
         for v in self.vehicles:
             names = []
             for var in self.continuous_states:
                 i = self.state_index(var, v)
-                names.append(None if i < 0 else (list(linear_model(v).state_names) + ["psi1", "Y1"])[i])
+                names.append(None if i < 0 else (list(linear_model(v, self.model).state_names) + ["psi1", "Y1"])[i])
             if v.steered_axles:
-                r = response(v, u, sine(0.01, 0.4), 10.5, 0.01)
+                r = response(v, u, sine(0.01, 0.4), 10.5, 0.01, model=self.model)
             else:
-                co = system_coefficients(v)
-                r = response(v, u, step(0.0), 10.0, 0.01, F=1e3 * co.B_P[:, -1])
+                co = linear_model(v, self.model)
+                force = np.zeros(len(v.axles))
+                force[-1] = 1e3
+                r = response(v, u, step(0.0), 10.0, 0.01, F=1e3 * co.B_P[:, -1], model=self.model,
+                             axle_force_N=force)
             got = r.peaks_abs([n for n in names if n is not None])
             k = 0
             for j, n in enumerate(names):
@@ -202,11 +208,12 @@ class Interface:
         """Index of a continuous state in the model's z = [x, psi1, Y1] of ``vehicle``; -1 for a
         state the vehicle lacks (a preset with fewer units)."""
         kind = variable.source[0]
+        model = linear_model(vehicle, self.model)
         if kind == "psi1":
-            return linear_model(vehicle).n_states
+            return model.n_states
         if kind == "Y1":
-            return linear_model(vehicle).n_states + 1
-        names = linear_model(vehicle).state_names
+            return model.n_states + 1
+        names = model.state_names
         return names.index(variable.source[1]) if variable.source[1] in names else -1
 
     def vehicle(self, preset: str | None = None) -> Vehicle:
@@ -331,10 +338,34 @@ def preset_interface() -> Interface:
                      "zero-order-hold stepping for any communication step size.")
 
 
-def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START) -> Interface:
+def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START, model: str = "yaw_plane") -> Interface:
     """The interface of an FMU with ``vehicle`` built in (docs/fmu.md); the input ``u``
-    starts at ``u_start_mps`` [m/s] (default 50 mph)."""
+    starts at ``u_start_mps`` [m/s] (default 50 mph).
+
+    ``model``: ``yaw_plane`` (default) or ``yaw_roll``, which appends (after every yaw-plane
+    variable, so their value references do not move) the roll rates ``p<i>`` [rad/s] and roll
+    angles ``phi<i>`` [rad] of the sprung masses, the sprung CGs' lateral accelerations
+    ``as<i>`` [m/s2], every axle's load transfer ``dFz_<axle>`` [N] and the load transfer ratio
+    ``ltr<g>`` [-] of every roll-coupled group.
+
+    Raises
+    ------
+    lcvreport.model.linear.ModelError
+        An unknown model.
+    lcvreport.model.vehicle.VehicleError
+        ``yaw_roll`` for a vehicle without (valid) roll data: the message names the key.
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> itf = vehicle_interface(load_vehicle("examples/vehicles/western_double.toml"), model="yaw_roll")
+    >>> [v.name for v in itf.outputs][-4:]
+    ['dFz_dolly_axle', 'dFz_trailer2_axle', 'ltr1', 'ltr2']
+    """
+    from ..model.linear import check_model
     RANGES["speed"].check(u_start_mps, "start speed")
+    model = check_model(model)
+    co = linear_model(vehicle, model)               # the roll data checked: one line naming the key
     t = _Table("si")
     _parameters(t)
     steered = vehicle.steered_axles
@@ -376,7 +407,27 @@ def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START) -> Interfa
             t.add(f"Y_{a.name}", "output", "continuous", "length", None, f"Global lateral position of the centre of "
                   f"axle {a.name} of {u.name} (unit {i + 1}) from the start, +y (first order; HSTO is the rearmost "
                   "axle's overshoot in a lane change)", ("Y_axle", a.name))
-    desc = (f"Linear yaw-plane model of {vehicle.name} ({n} units: {', '.join(vehicle.unit_names)}) with residual "
+    if model == "yaw_roll":
+        for i, u in enumerate(vehicle.units):
+            t.add(f"p{i + 1}", "output", "continuous", "rate", None, f"Roll rate of the sprung mass of {u.name} "
+                  f"(unit {i + 1}), right side down positive", ("state", f"p{i + 1}"))
+        for i, u in enumerate(vehicle.units):
+            t.add(f"phi{i + 1}", "output", "continuous", "angle", None, f"Roll angle of the sprung mass of {u.name} "
+                  f"(unit {i + 1}), right side down positive", ("state", f"phi{i + 1}"))
+        for i, u in enumerate(vehicle.units):
+            t.add(f"as{i + 1}", "output", "continuous", "accel", None, f"Lateral acceleration of the sprung mass's "
+                  f"CG of {u.name} (unit {i + 1}), a_i + e_i p_i', at the current state and inputs", ("extra", f"as{i + 1}"))
+        for i, u in enumerate(vehicle.units):
+            for a in u.axles:
+                t.add(f"dFz_{a.name}", "output", "continuous", "force", None, f"Load transfer of axle {a.name} of "
+                      f"{u.name} (unit {i + 1}): (F_z,right - F_z,left)/2, at the current state and inputs",
+                      ("extra", f"dFz_{a.name}"))
+        for g, group in enumerate(co.roll.groups):
+            t.add(f"ltr{g + 1}", "output", "continuous", "factor", None, f"Load transfer ratio of roll-coupled group "
+                  f"{g + 1} ({', '.join(vehicle.units[i].name for i in group)}): sum dF_z / sum F_z0 over its axles, "
+                  "at the current state and inputs", ("extra", f"ltr{g + 1}"))
+    kind = "yaw-roll" if model == "yaw_roll" else "yaw-plane"
+    desc = (f"Linear {kind} model of {vehicle.name} ({n} units: {', '.join(vehicle.unit_names)}) with residual "
             "tire forces (conicity, ply steer). Exact zero-order-hold stepping for any communication step size."
             + (f" {vehicle.description}" if vehicle.description else ""))
-    return Interface(vehicle.name, tuple(t.vars), (vehicle,), False, desc)
+    return Interface(vehicle.name, tuple(t.vars), (vehicle,), False, desc, model)

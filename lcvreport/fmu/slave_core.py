@@ -31,7 +31,7 @@ def _interface(resources: str):
     if cfg["mode"] == "presets":
         return preset_interface()
     return vehicle_interface(load_vehicle(os.path.join(resources, cfg["vehicle_file"])),
-                             cfg.get("u_start_mps", U_START))
+                             cfg.get("u_start_mps", U_START), cfg.get("model", "yaw_plane"))
 
 
 class SlaveCore:

@@ -165,6 +165,14 @@ class LinearModel:
         n, na = self.n_states, len(self.vehicle.axles)
         return [], np.zeros((0, n)), np.zeros((0, n)), np.zeros(0), np.zeros((0, na))
 
+    def extra_signal_terms(self) -> dict:
+        """:meth:`extra_signals` split by speed and tire scale (``X = X0 + u X1 + (s/u) X2 + s X3``,
+        ``XD = XD0 + u XD1``, ``D = s D1``, ``O``); no rows for the yaw plane."""
+        n, na = self.n_states, len(self.vehicle.axles)
+        z = np.zeros((0, n))
+        return {"names": [], "X0": z, "X1": z, "X2": z, "X3": z, "XD0": z, "XD1": z, "D1": np.zeros(0),
+                "O": np.zeros((0, na))}
+
     def state_derivative_maps(self, speed_mps: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """(A, G) with ``x' = A x + G F``: ``A = M^-1 S``, ``G = M^-1`` (equilibrated solve).
 

@@ -218,6 +218,46 @@ class YawRollCoefficients(LinearCoefficients):
         O = np.vstack([np.zeros((n, na)), Lf, Wg @ Lf])
         return names, X, XD, D, O
 
+    def extra_signal_terms(self) -> dict:
+        """The outputs of :meth:`extra_signals` split by how they depend on the speed u [m/s] and
+        the tire scale s [-] (what the native FMU assembles at run time)::
+
+            X = X0 + u X1 + (s / u) X2 + s X3,   XD = XD0 + u XD1,   D = s D1,   O
+
+        Keys ``names``, ``X0, X1, X2, X3, XD0, XD1`` (rows x n), ``D1`` (rows,), ``O`` (rows x
+        n_axles); :meth:`extra_signals` at (u, s) equals the assembled terms to rounding (a test
+        holds them together)."""
+        n, rp, ns = self._n, self.roll, self.n_states
+        nq = 2 * n + 1
+        V0 = np.zeros((n, ns))
+        V0[:, :nq] = self.Jv
+        Vt = np.zeros((n, ns))
+        Vt[:, nq:nq + n - 1] = self.K
+        R = self.yaw_rate_map()
+        axles, which = self.vehicle.axles, self.vehicle.axle_units
+        na = len(axles)
+        X0, X2, X3 = (np.zeros((na, ns)) for _ in range(3))
+        D1 = np.zeros(na)
+        for j, (i, a) in enumerate(zip(which, axles)):
+            cf, hr, T = a.cornering_stiffness_axle_N_per_rad, rp.hr_m[i], rp.T_m[j]
+            X2[j] = hr * cf * (V0[i] + a.x_m * R[i]) / T
+            X3[j] = hr * cf * Vt[i] / T
+            X0[j, self.phi_index + i] = rp.K_Nm_per_rad[j] / T
+            X0[j, self.p_index + i] = rp.C_Nms_per_rad[j] / T
+            D1[j] = -hr * cf / T if a.steered else 0.0
+        O = np.diag(-rp.hr_m[rp.axle_unit] / rp.T_m)
+        Wg = self.ltr_weights()
+        ng = Wg.shape[0]
+        XD0 = V0.copy()
+        XD0[np.arange(n), self.p_index + np.arange(n)] += rp.e_m
+        zeros = lambda rows: np.zeros((rows, ns))  # noqa: E731
+        names = ([f"as{i + 1}" for i in range(n)] + [f"dFz_{a}" for a in self.vehicle.axle_names]
+                 + [f"ltr{g + 1}" for g in range(ng)])
+        return {"names": names,
+                "X0": np.vstack([zeros(n), X0, Wg @ X0]), "X1": np.vstack([R, zeros(na + ng)]),
+                "X2": np.vstack([zeros(n), X2, Wg @ X2]), "X3": np.vstack([zeros(n), X3, Wg @ X3]),
+                "XD0": np.vstack([XD0, zeros(na + ng)]), "XD1": np.vstack([Vt, zeros(na + ng)]),
+                "D1": np.r_[np.zeros(n), D1, Wg @ D1], "O": np.vstack([np.zeros((n, na)), O, Wg @ O])}
 
 def roll_moment_matrix(rp: RollParameters) -> np.ndarray:
     """``Kphi`` [N*m/rad]: the roll moment on every sprung mass per radian of roll of every unit
