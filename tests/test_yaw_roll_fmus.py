@@ -26,14 +26,13 @@ from lcvreport.manoeuvres.steer import step
 from lcvreport.model.linear import linear_model
 from lcvreport.model.vehicle_file import load_vehicle
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, TOOLS
 from fmu_support import Slave, run_schedule
 from helpers import held_inputs, schedule_condition, tolerance
 
 pytestmark = pytest.mark.xdist_group("yaw_roll_fmus")
 
 NAMES = ("western_double", "b_double")
-TOOLS = Path(__file__).resolve().parents[2] / "shared" / "tools"
 TIRE_SCALE, CROSSFALL = 0.9, 2.0
 
 
@@ -190,9 +189,10 @@ def test_fmi3_is_fmi2_to_the_last_bit_or_the_conditioning(roll_fmus, kind):
 
 
 def _tool(name: str) -> Path:
+    """An independent FMI importer (conftest.TOOLS): a test that needs one fails without it, as
+    test_fmu_tools' do."""
     p = TOOLS / name
-    if not p.exists():
-        pytest.skip(f"{p} is not on this machine")
+    assert p.exists(), f"{p} is missing: the FMI tools (../shared/tools) are needed"
     return p
 
 

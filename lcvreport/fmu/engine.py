@@ -48,6 +48,10 @@ from ..util.numerics import expm
 from .interface import Interface
 
 
+#: the step's numpy calls, bound once (a global name, not an attribute chain, per step)
+_matmul, _add_reduce, _sin, _isfinite = np.matmul, np.add.reduce, np.sin, math.isfinite
+
+
 class CosimError(ValueError):
     """A bad parameter, input or call; ``variable`` names it."""
 
@@ -114,11 +118,14 @@ class LCVEngine:
         self._steps = LRUCache(cache_size)
         self._speeds = LRUCache(1024)
         self._steps_out = LRUCache(cache_size)
+        # [z, w, 1]: the state lives in this buffer (``z`` is a view of it), the inputs are copied in
         self._zw = np.zeros(self.m + len(self.input_names) + 1)
         self._zw[-1] = 1.0
+        self._z = self._zw[:self.m]
+        self._w_at = slice(self.m, -1)
         self.stepped_outputs = None
         self._last_h = None
-        self._last_key = None
+        self._last_u = self._last_step_h = None
         self._last_K = None
         self.reset()
 
@@ -188,6 +195,15 @@ class LCVEngine:
             elif kind == "max_real_eig":
                 self._eig_out = o
         self._has_y = bool(np.any(self._W))
+        # the step's buffers: its product [z, linear outputs, Theta] and views of it, the outputs
+        n_out = len(self.output_names)
+        rows = m + n_out + (nu - 1 if self._has_y else 0)
+        self._res = np.zeros(rows)
+        self._res_z, self._res_outputs, self._res_angles = self._res[:m], self._res[m:m + n_out], self._res[m + n_out:]
+        self._out = np.zeros(n_out)
+        self._F = np.zeros((n_out, rows))
+        self._F[:, m:m + n_out] = np.eye(n_out)
+        self._F[:, m + n_out:] = self._W
 
     def maps(self) -> dict:
         """The engine's input and output maps (what the C FMU's generated data holds):
@@ -210,6 +226,15 @@ class LCVEngine:
     def start_inputs(self) -> np.ndarray:
         """The inputs' start values (interface order), SI."""
         return np.array([float(v.start) for v in self.interface.inputs])
+
+    @property
+    def z(self) -> np.ndarray:
+        """The state ``[x, psi1, Y1]`` (SI; a view of the engine's buffer: copy it to keep it)."""
+        return self._z
+
+    @z.setter
+    def z(self, value) -> None:
+        self._z[:] = value
 
     def reset(self) -> None:
         """Back to rest at time 0 (keeps the caches)."""
@@ -279,6 +304,9 @@ class LCVEngine:
             if self._has_y:
                 rows.append(self._H @ K)
             out = np.vstack(rows)
+            if self._eig_out >= 0:                               # a constant at this speed
+                out[self.m + self._eig_out] = 0.0
+                out[self.m + self._eig_out, -1] = self.max_real_eig(u)
             out.setflags(write=False)
             return out
         return self._steps_out.get((u, h), compute)
@@ -332,42 +360,41 @@ class LCVEngine:
                 raise CosimError("communicationStepSize", f"communication step size must be in {r.text()}, got "
                                                           f"{h!r}; the step is refused")
             self._last_h = h
-        w = np.asarray(w, dtype=float)
         if not checked:
+            w = np.asarray(w, dtype=float)
             self.check_inputs(w)
-        u_in = float(w[0])
-        u = u_in if u_in >= self.u_min else self.u_min
+        u = float(w[0])
         warning = None
-        if u_in < self.u_min:
+        clamped = u < self.u_min
+        if clamped:
             if not self.clamped:
-                warning = (f"u = {u_in:.6g} m/s is below u_min = {self.u_min:.6g} m/s; the model runs at u_min "
+                warning = (f"u = {u:.6g} m/s is below u_min = {self.u_min:.6g} m/s; the model runs at u_min "
                            "until u rises again (the linear model needs a forward speed)")
-            clamped = True
-        else:
-            clamped = False
-        key = (u, h)
-        if key != self._last_key:
+            u = self.u_min
+        if u != self._last_u or h != self._last_step_h:
             self._last_K = self._step_output_matrix(u, h)
-            self._last_key = key
-            self._last_eig = self.max_real_eig(u) if self._eig_out >= 0 else 0.0
-        # one product gives the new state, the outputs at it (inputs held) and the angles
-        # whose sines the rear-end offsets need
-        res = self._last_K @ self.stacked(w)
+            self._last_u, self._last_step_h = u, h
+        # one product gives the new state, the outputs at it (inputs held), max_real_eig (its
+        # constant column) and the angles whose sines the rear-end offsets need; buffers and their
+        # views are made once (_build_maps)
+        zw, res = self._zw, self._res
+        zw[self._w_at] = w                         # the state is in place already
+        _matmul(self._last_K, zw, out=res)
         # the sum is finite exactly when every element is (an inf or a NaN propagates), unless
         # finite elements overflow it, i.e. above 1e307: refused too, as no state can be that large
-        if not math.isfinite(res.sum()):
+        if not _isfinite(_add_reduce(res)):
             raise CosimError("state", f"the step to t = {self.time + h:.6g} s is refused: its result is not finite "
                                       f"(the vehicle is unstable at u = {u:.6g} m/s, max Re(lambda) = "
                                       f"{self.max_real_eig(u):.4g} 1/s); the state is unchanged")
-        m, n_out = self.m, len(self.output_names)
-        z_new = res[:m]
-        out = res[m:m + n_out]
-        if self._has_y:
-            out += self._W @ np.sin(res[m + n_out:])
-        if self._eig_out >= 0:
-            out[self._eig_out] = self._last_eig
+        out = self._out
+        if self._has_y:                            # outputs = [0 I W] [z, linear outputs, sin(Theta)]
+            angles = self._res_angles
+            _sin(angles, out=angles)
+            _matmul(self._F, res, out=out)
+        else:
+            out[...] = self._res_outputs
         self.stepped_outputs = out
-        self.z = z_new
+        self._z[...] = self._res_z
         self.time += h
         self.clamped = clamped
         self.last_speed_mps = u
@@ -395,7 +422,6 @@ class LCVEngine:
     def stacked(self, w) -> np.ndarray:
         """``[z, w]`` in a buffer of the engine (valid until the next call)."""
         zw = self._zw
-        zw[:self.m] = self.z
         zw[self.m:-1] = w
         return zw
 
@@ -470,7 +496,8 @@ class LCVEngine:
             raise CosimError("FMUstate", f"the FMU state holds {z.size} values; {self.vehicle.name} needs {self.m}")
         if not (np.all(np.isfinite(z)) and math.isfinite(t) and math.isfinite(last)):
             raise CosimError("FMUstate", "the FMU state holds numbers that are not finite")
-        self.z, self.time, self.clamped, self.last_speed_mps = z, t, clamped, last
+        self.z = z
+        self.time, self.clamped, self.last_speed_mps = t, clamped, last
         self.stepped_outputs = None
 
 

@@ -59,6 +59,7 @@ class SlaveCore:
         self._problem = False                 # False: not checked since the inputs changed
         self._feed_problem = False            # the same for the outputs that feed inputs through (ay)
         self._values = None
+        self._stepped = False
         self._input_vrs = np.array([v.value_reference for v in self.itf.inputs], dtype=int)
         self._output_vrs = np.array([v.value_reference for v in self.itf.outputs], dtype=int)
         self._values_speed = None             # the speed _values_V and _values_c are for
@@ -71,6 +72,7 @@ class SlaveCore:
         self._first_input = first
         self._bad_vrs = frozenset()
         self._real_vrs = frozenset(v.value_reference for v in self.itf.variables if v.type == "Real")
+        self._last_get, self._last_slice, self._out_slice = None, None, None   # the last all-Real GetReal
         self._template = self._parameter_values()
 
     # ---------------------------------------------------------------- errors
@@ -103,6 +105,7 @@ class SlaveCore:
             self.init_error = None
             self.initialized = True
             self._values = None
+            self._stepped = False
             self._values_speed = None
         except CosimError as exc:
             self.engine = None
@@ -119,14 +122,16 @@ class SlaveCore:
                 self._error(self.init_error and f"{self.init_error}; every doStep will be refused"
                             or f"{self._fn('DoStep')} called before initialization completed")
                 return False
-            if self._problem is False:
+            if self._problem is False:          # the inputs changed: check them, list them once
                 self._problem = self.engine.input_problem(self.inputs)
+                self._prefix_inputs = self._prefix + self.inputs.tolist()
             if self._problem is not None:
                 raise self._problem
             warning = self.engine.step(float(step_size), self.inputs, checked=True)
-            # every value at once: the parameters, the inputs held, the outputs the step gave
-            self._values = (self._prefix + self.inputs.tolist() + self.engine.stepped_outputs.tolist()
-                            if self._contiguous else None)
+            # the values are the parameters, the inputs held and the outputs the step gave: listed
+            # when a host asks (a host reading the outputs gets them as one slice)
+            self._values = None
+            self._stepped = self._contiguous
             self._bad_vrs = frozenset()
             if warning:
                 self._warning(warning)
@@ -155,8 +160,15 @@ class SlaveCore:
 
     def get_real(self, vrs):
         try:
-            values = self._values if self._values is not None else self._all_values()
+            if self._stepped and self._out_slice is not None and vrs == self._last_get:
+                return self.engine.stepped_outputs[self._out_slice].tolist()     # outputs only, after a step
+            values = self._values if self._values is not None else self._current_values()
+            if vrs == self._last_get:           # the host asks for what it asked for last time
+                if self._bad_vrs and not self._bad_vrs.isdisjoint(vrs):
+                    self._error(self.engine.output_error or "an output is not finite")
+                return values[self._last_slice] if self._last_slice is not None else [values[vr] for vr in vrs]
             if self._real_vrs.issuperset(vrs):
+                self._remember_get(vrs)
                 if self._bad_vrs and not self._bad_vrs.isdisjoint(vrs):
                     self._error(self.engine.output_error or "an output is not finite")
                 return [values[vr] for vr in vrs]
@@ -167,6 +179,27 @@ class SlaveCore:
         except Exception as exc:  # noqa: BLE001
             self._error(f"{self._fn('GetReal')} failed: {type(exc).__name__}: {exc}")
             return [0.0] * len(vrs)
+
+    def _remember_get(self, vrs) -> None:
+        """Keep ``vrs`` (all Real) for the next call, with the slice of the values they are when
+        they are consecutive (a host reading every output reads one slice)."""
+        vrs = list(vrs)
+        n = len(vrs)
+        self._last_get = vrs
+        consecutive = bool(n) and vrs == list(range(vrs[0], vrs[0] + n))
+        self._last_slice = slice(vrs[0], vrs[0] + n) if consecutive else None
+        first = int(self._output_vrs[0]) if len(self._output_vrs) else -1
+        self._out_slice = (slice(vrs[0] - first, vrs[0] - first + n)
+                           if consecutive and self._contiguous and first <= vrs[0] and vrs[-1] < first + len(
+                               self._output_vrs) else None)
+
+    def _current_values(self) -> list:
+        """Every Real value by value reference: after a step the parameters, the inputs and the
+        stepped outputs; else :meth:`_all_values`."""
+        if self._stepped:
+            self._values = self._prefix_inputs + self.engine.stepped_outputs.tolist()
+            return self._values
+        return self._all_values()
 
     def _all_values(self) -> list:
         """Every Real value by value reference (0.0 for non-finite outputs, whose value
@@ -229,6 +262,7 @@ class SlaveCore:
         finally:
             self._problem = self._feed_problem = False
             self._values = None
+            self._stepped = False
 
     def _set_parameter(self, name: str, value) -> None:
         """A fixed parameter takes a value before initialization ends, never after."""
@@ -236,7 +270,9 @@ class SlaveCore:
             self._error(f"{name} is a fixed parameter: it cannot change after initialization")
         else:
             self.params[name] = value
+            self._problem = False                  # the values' prefix is listed again
             self._values = None
+            self._stepped = False
             self._values_speed = None
             self._template = self._parameter_values()
 
@@ -337,6 +373,7 @@ class SlaveCore:
             self.params, self.inputs, self.engine = params, np.array(inputs, dtype=float), engine
             self._problem = self._feed_problem = False
             self._values = None
+            self._stepped = False
             self._values_speed = None
             self._template = self._parameter_values()
             self.initialized, self.init_error = bool(state["initialized"]), state["init_error"]
