@@ -162,6 +162,56 @@ def part2() -> None:
           f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')})")
 
 
+def part3() -> None:
+    """The critical speed (issue 32): the lazy scan against the whole-grid scan it replaces
+    (tests/legacy_critical_speed.py, verbatim: the baseline the code under test cannot change),
+    interleaved, one vehicle (every preset and example at six tire scales) and batched (3 x 256
+    random variants of three presets at three tire scales); the answers are compared too."""
+    import sys
+    sys.path.insert(0, str(ROOT / "tests"))
+    import legacy_critical_speed as legacy
+    from lcvreport.analysis.batch import VariantBatch
+    from lcvreport.measures.stability import critical_speed_batched
+    legacy.VariantBatch = VariantBatch
+    vehicles = [load_preset(p) for p in PRESETS] + [load_vehicle(p) for p in
+                                                    sorted((ROOT / "examples" / "vehicles").glob("*.toml"))]
+    cases = [(v, s) for v in vehicles for s in (1.0, 0.5, 0.3, 0.2, 0.15, 0.1)]
+    old = new = 0.0
+    same = 0
+    for rnd in range(3):
+        t0 = time.perf_counter()
+        a = [legacy.legacy_critical_speed(v, s) for v, s in cases]
+        t1 = time.perf_counter()
+        b = [critical_speed(v, s) for v, s in cases]
+        t2 = time.perf_counter()
+        old, new = (t1 - t0, t2 - t1) if rnd == 0 else (min(old, t1 - t0), min(new, t2 - t1))
+        same = sum(x == y for x, y in zip(a, b))
+    print(f"critical speed, one vehicle ({len(cases)} cases): whole-grid scan {old / len(cases) * 1e3:.2f} ms, "
+          f"lazy scan {new / len(cases) * 1e3:.2f} ms per case: {old / new:.2f}x (target >= 1.5); "
+          f"same answer in {same} of {len(cases)}")
+    rng = np.random.default_rng(3)
+    t_old = t_new = 0.0
+    n = differ = 0
+    for name in ("empty", "legal_max", "aucnat"):
+        v = load_preset(name)
+        keys = [f"{u.name}.mass_kg" for u in v.units] + [f"{x.name}.cornering_stiffness_N_per_rad" for x in v.axles]
+        nominal = {f"{u.name}.mass_kg": u.mass_kg for u in v.units}
+        nominal.update({f"{x.name}.cornering_stiffness_N_per_rad": x.cornering_stiffness_N_per_rad for x in v.axles})
+        batch = VariantBatch(v, {k: nominal[k] * rng.uniform(0.6, 1.4, 256) for k in keys})
+        for s in (1.0, 0.3, 0.15):
+            t0 = time.perf_counter()
+            a = legacy.legacy_critical_speed_batched(batch, s)
+            t1 = time.perf_counter()
+            b = critical_speed_batched(batch, s)
+            t2 = time.perf_counter()
+            t_old, t_new = t_old + t1 - t0, t_new + t2 - t1
+            n += a.size
+            differ += int((np.nan_to_num(a, nan=-1.0) != np.nan_to_num(b, nan=-1.0)).sum())
+    print(f"critical speed, batched ({n} variants): whole-grid scan {t_old:.2f} s, lazy scan {t_new:.2f} s: "
+          f"{t_old / t_new:.2f}x (target >= 1.8); answers differing: {differ}")
+
+
 if __name__ == "__main__":
     main()
     part2()
+    part3()

@@ -61,6 +61,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
 ``measures/``            **the field's measures**, one family per module:
     ``registry``         every measure once: key, label, unit, definition, limit kind, how it is batched
     ``stability``        least damping, critical speed, speed sweep
+    ``crossings``        every speed an eigenvalue crosses the imaginary axis (the exact check of the critical speed)
     ``amplification``    single-sine RA, the RA peak
     ``yaw_damping``      yaw damping coefficient (ratio method)
     ``offtracking``      HSTO and RA of the lane change, HSSO

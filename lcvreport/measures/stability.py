@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -60,12 +61,11 @@ def critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: float =
     """Lowest speed [km/h] in ``(u_min, u_max]`` where ``max Re(lambda) >= 0`` (of the linear
     model ``model``), to 0.1 km/h; None if stable.
 
-    ``max Re(lambda)`` is scanned every 4 km/h; every interval whose ends are not
-    clearly stable -- closer to 0 than twice the largest change of ``max Re(lambda)``
-    over that interval and its neighbours -- is scanned again every 1 km/h; bisection
-    narrows the first unstable speed to 0.01 km/h, rounded to 0.1 km/h.  An instability
-    band narrower than 1 km/h can be missed (none of the vehicles here has one); the result
-    equals a dense scan (tested).
+    The scan of :func:`first_unstable_speeds` (docs/measures.md#critical-speed): the grid every
+    4 km/h looked at every 16 km/h first, opened where doubtful, every 1 km/h where doubtful
+    below the first unstable point, bisection to 0.01 km/h, rounded to 0.1 km/h.  An instability
+    band narrower than the scan's steps can be missed: :func:`stability_crossings` computes every
+    speed where an eigenvalue crosses the imaginary axis, exactly (the tests hold the two together).
 
     Examples
     --------
@@ -76,39 +76,166 @@ def critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: float =
     check_tire_scale(tire_scale)
     lo_kph = mps_to_kph(RANGES["u_min"].check(u_min_mps, "u_min"))
 
-    def max_real(v_kph):
+    def evaluate(_rows, v_kph):
         A = state_matrix(vehicle, kph_to_mps(np.asarray(v_kph, dtype=float)), tire_scale, model)
         return np.linalg.eigvals(A).real.max(axis=-1)
 
-    coarse = np.linspace(lo_kph, u_max_kph, max(int(math.ceil((u_max_kph - lo_kph) / 4.0)) + 1, 2))
-    sigma = max_real(coarse)
-    # local change of max Re(lambda) per interval: the largest over it and its neighbours;
-    # a function changing by at most that much rises at most half of it above the
-    # interval's ends: twice that margin decides which intervals are scanned finely
-    step = np.abs(np.diff(sigma))
-    padded = np.concatenate([step[:1], step, step[-1:]])
-    slope = np.maximum(np.maximum(padded[:-2], padded[1:-1]), padded[2:])
-    near = np.flatnonzero(np.maximum(sigma[:-1], sigma[1:]) > -2.0 * slope)
-    fine = np.concatenate([np.linspace(coarse[i], coarse[i + 1], int(math.ceil(coarse[i + 1] - coarse[i])) + 1)[1:-1]
-                           for i in near] or [np.empty(0)])
-    grid = np.concatenate([coarse, fine])
-    order = np.argsort(grid, kind="stable")
-    values = np.concatenate([sigma, max_real(fine) if fine.size else fine])
-    grid, values = grid[order], values[order]
-    flags = values >= 0.0
-    if not flags.any():
-        return None
-    i = int(np.argmax(flags))
-    if i == 0:
-        return round(float(grid[0]), 1)
-    lo, hi = float(grid[i - 1]), float(grid[i])
-    while hi - lo > 0.01:
-        mid = 0.5 * (lo + hi)
-        if max_real(mid) >= 0.0:
-            hi = mid
-        else:
-            lo = mid
-    return round(0.5 * (lo + hi), 1)
+    out = first_unstable_speeds(evaluate, 1, lo_kph, u_max_kph)[0]
+    return None if math.isnan(out) else float(out)
+
+
+def first_unstable_speeds(evaluate, n_variants: int, lo_kph: float, hi_kph: float) -> np.ndarray:
+    """The critical speed [km/h] of each of ``n_variants`` (NaN: none up to ``hi_kph``), rounded
+    to 0.1 km/h, from ``evaluate(rows, v_kph) -> max Re(lambda)`` (variant ``rows[k]`` at speed
+    ``v_kph[k]``, arrays of one length).
+
+    The scan (docs/measures.md#critical-speed) is defined on the grid of ``ceil((hi - lo) / 4) + 1``
+    even points (about every 4 km/h): an interval of it is *doubtful* when ``max Re(lambda)`` at
+    either end is above ``-2 x`` the largest change of ``max Re(lambda)`` over that interval and its
+    two neighbours; the doubtful intervals are scanned every 1 km/h; the first unstable point
+    found and the point before it bracket a bisection to 0.01 km/h.  It is evaluated lazily: the
+    grid's every fourth point first, the same doubt rule on that coarse grid opens the groups of
+    four intervals worth looking at (each with one point beyond either side, so the rule on the
+    4 km/h grid sees what it would see on the whole grid), and the group ending at the first unstable
+    coarse point always; only intervals below the first unstable point are refined.  Where an
+    instability is not narrower than the coarse grid's doubt margin, this is the whole grid's scan
+    exactly (tests/test_critical_speed.py: the same answer as the whole-grid scan on every preset,
+    example and random variant tried), with about half its eigenvalue solves."""
+    B = n_variants
+    grid, coarse, fine, owner, order = _scan_grid(float(lo_kph), float(hi_kph))
+    K = grid.size
+    sigma = np.full((B, K), np.nan)                      # max Re(lambda) on the grid, NaN: not evaluated
+
+    def fill(mask):                                      # evaluate the grid points mask[b, k] not yet known
+        rows, cols = np.nonzero(mask & np.isnan(sigma))
+        if rows.size:
+            sigma[rows, cols] = evaluate(rows, grid[cols])
+
+    def doubtful(values):                                # the doubt rule on a grid of values (B, J)
+        step = np.abs(np.diff(values, axis=1))
+        padded = np.concatenate([step[:, :1], step, step[:, -1:]], axis=1)
+        with np.errstate(invalid="ignore"):
+            slope = np.maximum(np.maximum(padded[:, :-2], padded[:, 1:-1]), padded[:, 2:])
+            return np.maximum(values[:, :-1], values[:, 1:]) > -2.0 * slope
+
+    def below_first_unstable(values):                    # intervals at or below the first unstable point
+        unstable = values >= 0.0
+        first = np.where(unstable.any(axis=1), np.argmax(unstable, axis=1), values.shape[1])
+        return np.arange(values.shape[1] - 1)[None, :] < first[:, None]
+
+    # 1. every fourth grid point (and the last)
+    pick = np.zeros((B, K), bool)
+    pick[:, coarse] = True
+    fill(pick)
+    sc = sigma[:, coarse]
+    # 2. open the doubtful groups below the first unstable coarse point, and the group ending at it
+    open_group = below_first_unstable(sc) & (doubtful(sc) | _ends_at_first_unstable(sc))
+    want = np.zeros((B, K), bool)
+    for g in np.flatnonzero(open_group.any(axis=0)):
+        want[np.ix_(np.flatnonzero(open_group[:, g]), np.arange(max(coarse[g] - 1, 0), min(coarse[g + 1] + 2, K)))] = True
+    fill(want)
+    known = ~np.isnan(sigma)
+    # 3. the doubt rule on the 4 km/h grid where all it reads is known, below the first unstable point
+    with np.errstate(invalid="ignore"):
+        near = doubtful(np.where(known, sigma, np.nan)) & below_first_unstable(np.where(known, sigma, -np.inf))
+    use = near[:, owner]                                                                # (B, F)
+    fine_vals = np.full(use.shape, -np.inf)
+    rows, cols = np.nonzero(use)
+    if rows.size:
+        fine_vals[rows, cols] = evaluate(rows, fine[cols])
+    # 4. the first unstable point and the one before it bracket the bisection
+    points = np.concatenate([grid, fine])[order]
+    values = np.concatenate([np.where(known, sigma, -np.inf), fine_vals], axis=1)[:, order]
+    present = np.concatenate([known, use], axis=1)[:, order]
+    flags = (values >= 0.0) & present
+    out = np.full(B, np.nan)
+    found = flags.any(axis=1)
+    first = np.argmax(flags, axis=1)
+    out[found & (first == 0)] = np.round(points[0], 1)
+    todo = np.flatnonzero(found & (first > 0))
+    if todo.size:
+        idx = np.arange(points.size)
+        prev = np.array([idx[present[b] & (idx < first[b])].max() for b in todo])
+        lo, hi = points[prev].astype(float), points[first[todo]].astype(float)
+        s_lo, s_hi = values[todo, prev], values[todo, first[todo]]
+        lo, hi = _bisect(evaluate, todo, lo, hi, s_lo, s_hi)
+        out[todo] = np.round(0.5 * (lo + hi), 1)
+    return out
+
+
+def _bisect(evaluate, rows, lo, hi, s_lo, s_hi, width: float = 0.01):
+    """Bisection of each bracket ``[lo, hi]`` (``max Re(lambda)`` < 0 at lo, >= 0 at hi) to ``width``
+    [km/h]: at every midpoint, hi moves there where ``max Re(lambda) >= 0``, lo otherwise.  The
+    midpoints are evaluated several at a time: the path the bisection would take if the root lay
+    where the line through the bracket's ends crosses zero is evaluated in one call, and followed
+    as long as every sign it finds is the one predicted -- so the brackets, and the answer, are the
+    one-at-a-time bisection's exactly; a wrong prediction starts the next call from there."""
+    lo, hi, s_lo, s_hi = (np.array(x, dtype=float) for x in (lo, hi, s_lo, s_hi))
+    active = np.flatnonzero(hi - lo > width)
+    while active.size:
+        # the predicted paths (each to the end), the root where the chord crosses zero
+        root = lo[active] + (hi[active] - lo[active]) * (-s_lo[active]) / (s_hi[active] - s_lo[active])
+        a, b = lo[active].copy(), hi[active].copy()
+        paths = []
+        while True:
+            go = b - a > width
+            if not go.any():
+                break
+            mid = 0.5 * (a + b)
+            paths.append(np.where(go, mid, np.nan))
+            up = go & (mid >= root)
+            b = np.where(up, mid, b)
+            a = np.where(go & ~up, mid, a)
+        mids = np.array(paths).T                                      # (active, depth), NaN past a path's end
+        r, c = np.nonzero(~np.isnan(mids))
+        got = np.full(mids.shape, np.nan)
+        got[r, c] = evaluate(rows[active[r]], mids[r, c])
+        # replay: follow each path while its signs are the predicted ones
+        for k in range(mids.shape[1]):
+            live = np.flatnonzero((hi[active] - lo[active] > width) & ~np.isnan(mids[:, k]))
+            if not live.size:
+                break
+            j = active[live]
+            mid = 0.5 * (lo[j] + hi[j])
+            follows = mid == mids[live, k]                            # still on the predicted path
+            if not follows.any():
+                break
+            j, live, mid = j[follows], live[follows], mid[follows]
+            value = got[live, k]
+            unstable = value >= 0.0
+            hi[j] = np.where(unstable, mid, hi[j])
+            s_hi[j] = np.where(unstable, value, s_hi[j])
+            lo[j] = np.where(unstable, lo[j], mid)
+            s_lo[j] = np.where(unstable, s_lo[j], value)
+        active = np.flatnonzero(hi - lo > width)
+    return lo, hi
+
+
+@lru_cache(maxsize=16)
+def _scan_grid(lo_kph: float, hi_kph: float):
+    """The scan's points for a speed range (read-only): the grid (about every 4 km/h), the indices of
+    its every fourth point, the 1 km/h points inside each of its intervals and their interval, and
+    the order of grid and fine points together."""
+    grid = np.linspace(lo_kph, hi_kph, max(int(math.ceil((hi_kph - lo_kph) / 4.0)) + 1, 2))
+    K = grid.size
+    coarse = np.unique(np.r_[np.arange(0, K, 4), K - 1])
+    fine_of = [np.linspace(grid[i], grid[i + 1], int(math.ceil(grid[i + 1] - grid[i])) + 1)[1:-1] for i in range(K - 1)]
+    fine = np.concatenate(fine_of)
+    owner = np.concatenate([np.full(f.size, i) for i, f in enumerate(fine_of)])
+    order = np.argsort(np.concatenate([grid, fine]), kind="stable")
+    for arr in (grid, coarse, fine, owner, order):
+        arr.setflags(write=False)
+    return grid, coarse, fine, owner, order
+
+
+def _ends_at_first_unstable(values: np.ndarray) -> np.ndarray:
+    """(B, J-1): the interval of each row ending at its first unstable point."""
+    unstable = values >= 0.0
+    first = np.argmax(unstable, axis=1)
+    hit = unstable.any(axis=1) & (first > 0)
+    out = np.zeros((values.shape[0], values.shape[1] - 1), bool)
+    out[np.flatnonzero(hit), first[hit] - 1] = True
+    return out
 
 
 @dataclass(frozen=True)
@@ -172,58 +299,13 @@ def critical_speed_batched(batch: VariantBatch, tire_scale: float = 1.0, u_min_m
 
 def _critical_speed_batched(batch: VariantBatch, tire_scale: float = 1.0, u_min_mps: float | None = None,
                             u_max_kph: float | None = None) -> np.ndarray:
-    """The critical speed [km/h] of every variant (NaN: stable up to ``u_max_kph``), by the
-    algorithm of :func:`lcvreport.measures.stability.critical_speed` run on all variants at
-    once: the coarse 4 km/h scan, the 1 km/h scan of each variant's own doubtful intervals,
-    the bisection to 0.01 km/h, rounded to 0.1 km/h."""
-    from ..ranges import RANGES
-    from ..units import mps_to_kph
+    """The critical speed [km/h] of every variant (NaN: stable up to ``u_max_kph``): the scan of
+    :func:`first_unstable_speeds` on all variants at once (each variant evaluates only its own
+    points), as :func:`lcvreport.measures.stability.critical_speed` runs it on one."""
     u_max_kph = CRITICAL_SPEED_MAX_KPH if u_max_kph is None else u_max_kph
     lo_kph = mps_to_kph(RANGES["u_min"].check(U_MIN_DEFAULT_MPS if u_min_mps is None else u_min_mps, "u_min"))
-    B = batch.size
-    coarse = np.linspace(lo_kph, u_max_kph, max(int(math.ceil((u_max_kph - lo_kph) / 4.0)) + 1, 2))
-    sigma = batch.max_real_at(np.broadcast_to(coarse, (B, coarse.size)), tire_scale)     # (B, K)
-    step = np.abs(np.diff(sigma, axis=1))
-    padded = np.concatenate([step[:, :1], step, step[:, -1:]], axis=1)
-    slope = np.maximum(np.maximum(padded[:, :-2], padded[:, 1:-1]), padded[:, 2:])
-    near = np.maximum(sigma[:, :-1], sigma[:, 1:]) > -2.0 * slope                      # (B, K-1)
-    # the fine points of every interval; a variant evaluates only those of its own doubtful ones
-    fine_of = [np.linspace(coarse[i], coarse[i + 1], int(math.ceil(coarse[i + 1] - coarse[i])) + 1)[1:-1]
-               for i in range(coarse.size - 1)]
-    fine = np.concatenate(fine_of)
-    owner = np.concatenate([np.full(f.size, i) for i, f in enumerate(fine_of)])
-    use = near[:, owner]                                                                # (B, F)
-    fine_vals = np.full(use.shape, -np.inf)
-    rows, cols = np.nonzero(use)
-    if rows.size:
-        fine_vals[rows, cols] = batch.values_at(rows, fine[cols], tire_scale)
-    grid = np.concatenate([coarse, fine])
-    order = np.argsort(grid, kind="stable")
-    grid = grid[order]
-    values = np.concatenate([sigma, fine_vals], axis=1)[:, order]
-    present = np.concatenate([np.ones((B, coarse.size), bool), use], axis=1)[:, order]
-    flags = (values >= 0.0) & present
-    out = np.full(B, np.nan)
-    found = flags.any(axis=1)
-    first = np.argmax(flags, axis=1)
-    at_start = found & (first == 0)
-    out[at_start] = np.round(grid[0], 1)
-    todo = np.flatnonzero(found & (first > 0))
-    if todo.size:
-        # the previous evaluated grid point of each variant
-        idx = np.arange(grid.size)
-        prev = np.array([idx[present[b] & (idx < first[b])].max() for b in todo])
-        lo, hi = grid[prev].astype(float), grid[first[todo]].astype(float)
-        active = hi - lo > 0.01
-        while active.any():
-            mid = 0.5 * (lo + hi)
-            m = np.flatnonzero(active)
-            unstable = batch.values_at(todo[m], mid[m], tire_scale) >= 0.0
-            hi[m] = np.where(unstable, mid[m], hi[m])
-            lo[m] = np.where(unstable, lo[m], mid[m])
-            active = hi - lo > 0.01
-        out[todo] = np.round(0.5 * (lo + hi), 1)
-    return out
+    return first_unstable_speeds(lambda rows, v_kph: batch.values_at(rows, v_kph, tire_scale), batch.size, lo_kph,
+                                 u_max_kph)
 
 
 def least_damping_family(case: MeasureCase) -> tuple[dict, dict]:
