@@ -29,11 +29,6 @@ def legacy_critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: 
     band narrower than 1 km/h can be missed (none of the vehicles here has one); the result
     equals a dense scan (tested).
 
-    Examples
-    --------
-    >>> from lcvreport import load_preset
-    >>> critical_speed(load_preset("empty"), tire_scale=0.2)
-    73.9
     """
     check_tire_scale(tire_scale)
     lo_kph = mps_to_kph(RANGES["u_min"].check(u_min_mps, "u_min"))

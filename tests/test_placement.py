@@ -164,6 +164,58 @@ def test_24_positions_beat_10000_random_placements():
     assert abs(pl.offtracking_m) - pl.lower_bound_m <= GAP_M + TIE_M
 
 
+def _centred(n, seed):
+    rng = np.random.default_rng(seed)
+    return _tires([(rng.normal(0, 100), rng.normal(0, 50), 0, 0) for _ in range(n)], False)
+
+
+def test_a_set_that_can_cancel_is_placed_at_zero_without_an_integer_program(monkeypatch):
+    """aucnat's 30 positions, a centred set: the plan -- mounted and trimmed here, independently
+    of the search's sums -- is within half the tie band of zero offtracking and half the gap of
+    zero trim steer, so no plan does better (the brute force's optimum is >= 0 in both); found
+    without solving an integer program (only the relaxation, which allows zero); the same plan
+    twice (seeded)."""
+    import scipy.optimize
+    from lcvreport.tracking import placement
+    v = VEHICLES["aucnat"]
+    positions = _all_positions(v)
+    assert len(positions) == 30
+    calls = []
+    real = scipy.optimize.milp
+
+    def counting(*args, **kwargs):
+        calls.append(np.any(kwargs.get("integrality")))
+        return real(*args, **kwargs)
+    monkeypatch.setattr(scipy.optimize, "milp", counting)
+    for seed in (0, 2, 4):
+        tires = _centred(30, seed)
+        pl = place_tires(v, U88, tires, positions, draws=10)
+        _check_plan(v, U88, tires, positions, pl)
+        assert abs(pl.offtracking_m) <= 0.5 * TIE_M and abs(pl.trim_delta_rad) <= 0.5 * placement.TIE_GAP_RAD
+        assert pl.lower_bound_m == 0.0
+        assert place_tires(v, U88, tires, positions, draws=10).plan == pl.plan
+    assert calls and not any(calls)                 # relaxations only
+
+
+def test_the_search_at_zero_and_the_integer_program_agree(monkeypatch):
+    """20 positions (aucnat's units 2..6), centred sets: with the search switched off the programs
+    find plans as good to their gaps; the search's plan is at zero in both."""
+    from lcvreport.tracking import placement
+    v = VEHICLES["aucnat"]
+    positions = [p for p in _all_positions(v) if not p.startswith(("11:", "12:", "13:"))]
+    for seed in (1, 3):
+        tires = _centred(len(positions), seed)
+        searched = place_tires(v, U88, tires, positions, draws=10)
+        with monkeypatch.context() as m:
+            m.setattr(placement, "NEAR_ZERO_MIN_TIRES", 10 ** 6)
+            programmed = place_tires(v, U88, tires, positions, draws=10)
+        _check_plan(v, U88, tires, positions, searched)
+        _check_plan(v, U88, tires, positions, programmed)
+        assert abs(searched.offtracking_m) <= 0.5 * TIE_M
+        assert abs(programmed.offtracking_m) <= GAP_M + TIE_M
+        assert abs(searched.trim_delta_rad) <= abs(programmed.trim_delta_rad) + placement.TIE_GAP_RAD
+
+
 def test_conicity_only_cancels():
     """Pairs of equal conicity and no ply steer: mounted facing opposite ways on one axle they cancel."""
     v = VEHICLES["tractor_semitrailer"]

@@ -4,15 +4,20 @@ Given measured tires (conicity and ply steer forces, optionally moments) and the
 positions to fill, find the plan -- a tire and a serial side for every position -- that
 minimizes the trimmed offtracking's magnitude, ties broken by the trim steer's magnitude.
 
-It is solved exactly as a mixed-integer linear program (HiGHS through
-:func:`scipy.optimize.milp`).  Positions on one axle are interchangeable (the tire's
+When the tires can cancel -- a plan with |offtracking| and |trim steer| both at zero (within
+half of :data:`TIE_M` and :data:`TIE_GAP_RAD`) exists, the usual case with a dozen tires or more
+-- that plan is optimal (no plan does better than 0) and is found directly: for a few seeded
+placements of the tires, every combination of serial sides is searched by meeting two halves in
+the middle (:func:`_near_zero_plan`; a tire's ply steer stays, its conicity flips).  Otherwise
+it is solved exactly as a mixed-integer linear program (HiGHS through
+:func:`scipy.optimize.milp`), where the optimum is away from zero and its bound proves it.  Positions on one axle are interchangeable (the tire's
 force acts on its axle whatever the slot), so the program decides, per tire, an axle and
 the direction its serial side faces (+y or -y): binaries ``y[i, a, s]`` with every tire
 used once and every axle given its number of tires; ``|O| <= t`` minimized, where
 ``O = O_0 + sum y[i, a, s] g_a (p_i + s c_i) + ...`` is the trimmed offtracking (linear
 in the tire forces, the sensitivities ``g`` of :func:`lcvreport.tracking.tires.sensitivities`).
 A second program keeps ``|O|`` within :data:`TIE_M` of the optimum and minimizes the
-trim steer's magnitude.  The slots of an axle are then filled in order, and each tire's
+trim steer's magnitude (to :data:`TIE_GAP_RAD`).  The slots of an axle are then filled in order, and each tire's
 serial side (``out``/``in``) follows from its slot and the direction chosen.
 
 The answer is checked, not trusted: the rounded plan is mounted with
@@ -62,6 +67,14 @@ RANDOM_DRAWS = 10_000
 SEED = 20110801
 #: the solver's time limit per program [s]
 TIME_LIMIT_S = 120.0
+#: optimality of the tie-break's |trim steer| [rad] (HiGHS's absolute gap, objective in rad)
+TIE_GAP_RAD = 1e-6
+#: plans the search for a plan at zero looks at (:func:`_near_zero_plan`), and the fewest tires it is tried on
+NEAR_ZERO_BUDGET = 1 << 33
+#: up to 16 tires: the plans looked at one by one, and the placements at most
+NEAR_ZERO_FULL_BUDGET = 1 << 27
+NEAR_ZERO_PLACEMENTS = 8192
+NEAR_ZERO_MIN_TIRES = 10
 #: measured-tire columns
 COLUMNS = ("id", "conicity_N", "ply_steer_N")
 OPTIONAL = ("conicity_moment_Nm", "ply_steer_moment_Nm")
@@ -222,6 +235,85 @@ def _evaluate(vehicle, speed_mps, mounted, F_const, tire_scale):
     return tr.offtracking_m, tr.delta_rad
 
 
+def _near_zero_plan(coef: np.ndarray, const: np.ndarray, slot_axle: np.ndarray, seed: int,
+                    budget: int = NEAR_ZERO_BUDGET, half: int = 16) -> np.ndarray | None:
+    """A plan with |offtracking| <= TIE_M / 2 and |trim steer| <= TIE_GAP_RAD / 2, or None.
+
+    Such a plan is optimal for both programs (nothing does better than 0), so when the measured
+    set can cancel it is the answer and no program is solved.  For placements of the tires (the
+    listed one, then seeded random ones) only the serial sides are searched: a tire's ply steer
+    stays, its conicity flips with the side, so (O, delta) is a base point plus a signed sum of each
+    tire's flip vector.  Up to 16 tires, every sign pattern of many placements at once; beyond, the
+    sign patterns of two halves of up to ``half`` tires each met in the middle (sorted by O, every
+    pair with |O| in the band looked at): about ``budget`` plans in all (:data:`NEAR_ZERO_FULL_BUDGET`
+    up to 16 tires).
+    Deterministic (seeded); ``coef`` is (2, tire, axle, facing)."""
+    _two, n, _A, _two_f = coef.shape
+    if n < NEAR_ZERO_MIN_TIRES:
+        return None
+    rng = np.random.default_rng(seed)
+
+    def placement(r):
+        tire_of = np.arange(n) if r == 0 else rng.permutation(n)          # tire_of[k] goes to slot k
+        plus, minus = coef[:, tire_of, slot_axle, 0], coef[:, tire_of, slot_axle, 1]
+        return tire_of, const + 0.5 * (plus + minus).sum(axis=1), 0.5 * (plus - minus)   # base point, flips
+
+    def plan(tire_of, facing):
+        y = np.zeros(coef.shape[1:])
+        y[tire_of, slot_axle, np.where(facing > 0, 0, 1)] = 1.0
+        return y
+
+    if n <= half:                                                          # every sign pattern
+        _S, signs = _signed_sums(np.zeros((2, n)))
+        per = max(1, min(256, (1 << 22) >> n))                             # placements per batch
+        for start in range(0, min(NEAR_ZERO_PLACEMENTS, max(NEAR_ZERO_FULL_BUDGET >> n, 1)), per):
+            batch = [placement(start + j) for j in range(per)]
+            pts = np.stack([b for _t, b, _f in batch])[:, :, None] + np.einsum(
+                "pkn,sn->pks", np.stack([f for _t, _b, f in batch]), signs)  # (P, 2, 2^n)
+            ok = (np.abs(pts[:, 0]) <= 0.5 * TIE_M) & (np.abs(pts[:, 1]) <= 0.5 * TIE_GAP_RAD)
+            if ok.any():
+                p, k = np.argwhere(ok)[0]
+                return plan(batch[p][0], signs[k])
+        return None
+    ka = min(half, n // 2)
+    kb = min(half, n - ka)
+    for r in range(max(8, budget >> (ka + kb))):
+        tire_of, point, flip = placement(r)
+        order = rng.permutation(n)
+        A_idx, B_idx, rest = order[:ka], order[ka:ka + kb], order[ka + kb:]
+        point = point + flip[:, rest].sum(axis=1)                          # the rest: serial side +y
+        SA, FA = _signed_sums(flip[:, A_idx])
+        SB, FB = _signed_sums(flip[:, B_idx])
+        srt = np.argsort(SB[0], kind="stable")
+        sb0 = SB[0][srt]
+        target = -(point[0] + SA[0])
+        lo = np.searchsorted(sb0, target - 0.5 * TIE_M, side="left")
+        counts = np.searchsorted(sb0, target + 0.5 * TIE_M, side="right") - lo
+        total = int(counts.sum())
+        if not total:
+            continue
+        a = np.repeat(np.arange(counts.size), counts)
+        b = srt[np.repeat(lo, counts) + (np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts))]
+        O = point[0] + SA[0][a] + SB[0][b]
+        D = point[1] + SA[1][a] + SB[1][b]
+        ok = np.flatnonzero((np.abs(O) <= 0.5 * TIE_M) & (np.abs(D) <= 0.5 * TIE_GAP_RAD))
+        if ok.size:
+            k = ok[0]
+            facing = np.ones(n)
+            facing[A_idx], facing[B_idx] = FA[a[k]], FB[b[k]]
+            return plan(tire_of, facing)
+    return None
+
+
+def _signed_sums(vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every signed sum of the columns of ``vectors`` (2, k): the sums (2, 2^k) and the signs of
+    column j in each (2^k, k)."""
+    k = vectors.shape[1]
+    bits = (np.arange(2 ** k)[:, None] >> np.arange(k)[None, :]) & 1
+    signs = 1.0 - 2.0 * bits
+    return vectors @ signs.T, signs
+
+
 def place_tires(vehicle: Vehicle, speed_mps: float, tires: list[dict], positions: list[str] | None = None,
                 F_const: np.ndarray | None = None, tire_scale: float = 1.0, draws: int = RANDOM_DRAWS,
                 seed: int = SEED) -> Placement:
@@ -322,18 +414,40 @@ def place_tires(vehicle: Vehicle, speed_mps: float, tires: list[dict], positions
             raise TrackingError("the placement program returned a plan that is not an assignment")
         return y, float(res.fun), float(getattr(res, "mip_dual_bound", res.fun))
 
-    y, _t_off, bound = solve(0, 1.0, None)
-    # ties: within TIE_M of the least |offtracking|, the least |trim steer| (to GAP_M rad).  The
-    # band is set from the first plan's own offtracking (HiGHS meets rows in metres only to
-    # about 1e-6 m, so its objective may undercut it), narrowed by FEASIBILITY_M, and written
-    # in micrometres; the tie plan is kept only if it keeps the band.
-    o_first = abs(const[0] + coef[0] @ y.ravel())
-    try:
-        y2 = solve(1, 1.0, o_first + TIE_M - FEASIBILITY_M)[0]
-        if abs(const[0] + coef[0] @ y2.ravel()) <= o_first + TIE_M:
-            y = y2
-    except TrackingError:
-        pass                                                      # keep the first plan: it is optimal for O
+    def relaxed() -> float:
+        """The least |O| [m] of the linear relaxation (tires split over axles and sides): a lower bound."""
+        t = np.zeros(nb + 1)
+        t[nb] = 1.0
+        obj = np.concatenate([coef[0], [0.0]])
+        cons = [LinearConstraint(assign, assign_lo, assign_lo),
+                LinearConstraint(np.vstack([obj - t, obj + t]), [-np.inf, -const[0]], [-const[0], np.inf])]
+        upper = np.ones(nb + 1)
+        upper[nb] = np.inf
+        with _quiet_stdout():
+            res = milp(t, constraints=cons, integrality=np.zeros(nb + 1), bounds=Bounds(np.zeros(nb + 1), upper))
+        return float(res.fun) if res.status == 0 else 0.0
+
+    slot_axle = np.array([axles.index(sl.axle) for sl in slots])
+    # a plan at zero is searched for only where the relaxation allows one (a set whose ply steer
+    # points one way cannot cancel: its optimum is away from zero and the program proves it fast)
+    y = _near_zero_plan(coef.reshape(2, n, A, 2), const, slot_axle, seed) if relaxed() <= 0.5 * TIE_M else None
+    if y is not None:
+        # |O| <= TIE_M / 2 and |trim steer| <= TIE_GAP_RAD / 2: optimal for both programs, as no
+        # plan does better than 0 (the plan lies in every tie band, whatever the least |O| is)
+        bound, o_first = 0.0, abs(const[0] + coef[0] @ y.ravel())
+    else:
+        y, _t_off, bound = solve(0, 1.0, None)
+        # ties: within TIE_M of the least |offtracking|, the least |trim steer| (to TIE_GAP_RAD).  The
+        # band is set from the first plan's own offtracking (HiGHS meets rows in metres only to
+        # about 1e-6 m, so its objective may undercut it), narrowed by FEASIBILITY_M, and written
+        # in micrometres; the tie plan is kept only if it keeps the band.
+        o_first = abs(const[0] + coef[0] @ y.ravel())
+        try:
+            y2 = solve(1, GAP_M / TIE_GAP_RAD, o_first + TIE_M - FEASIBILITY_M)[0]   # HiGHS's gap: TIE_GAP_RAD
+            if abs(const[0] + coef[0] @ y2.ravel()) <= o_first + TIE_M:
+                y = y2
+        except TrackingError:
+            pass                                                  # keep the first plan: it is optimal for O
     order, face = [None] * n, [0.0] * n
     for a_k, a in enumerate(axles):
         free = [k for k, s in enumerate(slots) if s.axle == a]
