@@ -71,8 +71,12 @@ TIME_LIMIT_S = 120.0
 TIE_GAP_RAD = 1e-6
 #: plans the search for a plan at zero looks at (:func:`_near_zero_plan`), and the fewest tires it is tried on
 NEAR_ZERO_BUDGET = 1 << 33
+#: "at zero": within 0.9 of the gaps (the rest for the plan's rounding when mounted anew)
+ZERO_M = 0.9 * min(GAP_M, TIE_M)
+ZERO_RAD = 0.9 * TIE_GAP_RAD
+NEAR_ZERO_RESTARTS = 256
 #: up to 16 tires: the plans looked at one by one, and the placements at most
-NEAR_ZERO_FULL_BUDGET = 1 << 27
+NEAR_ZERO_FULL_BUDGET = 1 << 25
 NEAR_ZERO_PLACEMENTS = 8192
 NEAR_ZERO_MIN_TIRES = 10
 #: measured-tire columns
@@ -237,9 +241,10 @@ def _evaluate(vehicle, speed_mps, mounted, F_const, tire_scale):
 
 def _near_zero_plan(coef: np.ndarray, const: np.ndarray, slot_axle: np.ndarray, seed: int,
                     budget: int = NEAR_ZERO_BUDGET, half: int = 16) -> np.ndarray | None:
-    """A plan with |offtracking| <= TIE_M / 2 and |trim steer| <= TIE_GAP_RAD / 2, or None.
+    """A plan with |offtracking| <= :data:`ZERO_M` and |trim steer| <= :data:`ZERO_RAD`, or None.
 
-    Such a plan is optimal for both programs (nothing does better than 0), so when the measured
+    Such a plan is optimal for both programs to their gaps (nothing does better than 0, and it lies
+    in every tie band: ZERO_M is below GAP_M and TIE_M, ZERO_RAD below TIE_GAP_RAD), so when the measured
     set can cancel it is the answer and no program is solved.  For placements of the tires (the
     listed one, then seeded random ones) only the serial sides are searched: a tire's ply steer
     stays, its conicity flips with the side, so (O, delta) is a base point plus a signed sum of each
@@ -253,8 +258,13 @@ def _near_zero_plan(coef: np.ndarray, const: np.ndarray, slot_axle: np.ndarray, 
         return None
     rng = np.random.default_rng(seed)
 
+    exhaustive = _assignments(slot_axle) if n <= half else None             # every split over the axles, if few
+
     def placement(r):
-        tire_of = np.arange(n) if r == 0 else rng.permutation(n)          # tire_of[k] goes to slot k
+        if exhaustive is not None:
+            tire_of = exhaustive[r]
+        else:
+            tire_of = np.arange(n) if r == 0 else rng.permutation(n)      # tire_of[k] goes to slot k
         plus, minus = coef[:, tire_of, slot_axle, 0], coef[:, tire_of, slot_axle, 1]
         return tire_of, const + 0.5 * (plus + minus).sum(axis=1), 0.5 * (plus - minus)   # base point, flips
 
@@ -266,18 +276,20 @@ def _near_zero_plan(coef: np.ndarray, const: np.ndarray, slot_axle: np.ndarray, 
     if n <= half:                                                          # every sign pattern
         _S, signs = _signed_sums(np.zeros((2, n)))
         per = max(1, min(256, (1 << 22) >> n))                             # placements per batch
-        for start in range(0, min(NEAR_ZERO_PLACEMENTS, max(NEAR_ZERO_FULL_BUDGET >> n, 1)), per):
-            batch = [placement(start + j) for j in range(per)]
-            pts = np.stack([b for _t, b, _f in batch])[:, :, None] + np.einsum(
-                "pkn,sn->pks", np.stack([f for _t, _b, f in batch]), signs)  # (P, 2, 2^n)
-            ok = (np.abs(pts[:, 0]) <= 0.5 * TIE_M) & (np.abs(pts[:, 1]) <= 0.5 * TIE_GAP_RAD)
+        count = len(exhaustive) if exhaustive is not None else min(NEAR_ZERO_PLACEMENTS,
+                                                                     max(NEAR_ZERO_FULL_BUDGET >> n, 1))
+        for start in range(0, count, per):
+            batch = [placement(r) for r in range(start, min(start + per, count))]
+            flips = np.stack([f for _t, _b, f in batch]).reshape(-1, n)      # (P * 2, n): one BLAS product
+            pts = np.stack([b for _t, b, _f in batch])[:, :, None] + (flips @ signs.T).reshape(len(batch), 2, -1)
+            ok = (np.abs(pts[:, 0]) <= ZERO_M) & (np.abs(pts[:, 1]) <= ZERO_RAD)
             if ok.any():
                 p, k = np.argwhere(ok)[0]
                 return plan(batch[p][0], signs[k])
         return None
     ka = min(half, n // 2)
     kb = min(half, n - ka)
-    for r in range(max(8, budget >> (ka + kb))):
+    for r in range(min(NEAR_ZERO_RESTARTS, max(8, budget >> (ka + kb)))):
         tire_of, point, flip = placement(r)
         order = rng.permutation(n)
         A_idx, B_idx, rest = order[:ka], order[ka:ka + kb], order[ka + kb:]
@@ -287,8 +299,8 @@ def _near_zero_plan(coef: np.ndarray, const: np.ndarray, slot_axle: np.ndarray, 
         srt = np.argsort(SB[0], kind="stable")
         sb0 = SB[0][srt]
         target = -(point[0] + SA[0])
-        lo = np.searchsorted(sb0, target - 0.5 * TIE_M, side="left")
-        counts = np.searchsorted(sb0, target + 0.5 * TIE_M, side="right") - lo
+        lo = np.searchsorted(sb0, target - ZERO_M, side="left")
+        counts = np.searchsorted(sb0, target + ZERO_M, side="right") - lo
         total = int(counts.sum())
         if not total:
             continue
@@ -296,13 +308,39 @@ def _near_zero_plan(coef: np.ndarray, const: np.ndarray, slot_axle: np.ndarray, 
         b = srt[np.repeat(lo, counts) + (np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts))]
         O = point[0] + SA[0][a] + SB[0][b]
         D = point[1] + SA[1][a] + SB[1][b]
-        ok = np.flatnonzero((np.abs(O) <= 0.5 * TIE_M) & (np.abs(D) <= 0.5 * TIE_GAP_RAD))
+        ok = np.flatnonzero((np.abs(O) <= ZERO_M) & (np.abs(D) <= ZERO_RAD))
         if ok.size:
             k = ok[0]
             facing = np.ones(n)
             facing[A_idx], facing[B_idx] = FA[a[k]], FB[b[k]]
             return plan(tire_of, facing)
     return None
+
+
+def _assignments(slot_axle: np.ndarray) -> list | None:
+    """Every distinct placement of the tires (which tires on which axle; the slots of an axle are
+    interchangeable) as ``tire_of`` arrays, if they and their serial sides number at most
+    :data:`NEAR_ZERO_FULL_BUDGET`; else None (then placements are drawn)."""
+    import itertools
+    import math
+    n = slot_axle.size
+    groups = [np.flatnonzero(slot_axle == a) for a in np.unique(slot_axle)]
+    total = math.factorial(n)
+    for g in groups:
+        total //= math.factorial(g.size)
+    if total << n > NEAR_ZERO_FULL_BUDGET:
+        return None
+    out = []
+
+    def split(remaining, k, tire_of):
+        if k == len(groups):
+            out.append(tire_of.copy())
+            return
+        for chosen in itertools.combinations(remaining, groups[k].size):
+            tire_of[groups[k]] = chosen
+            split([t for t in remaining if t not in chosen], k + 1, tire_of)
+    split(list(range(n)), 0, np.zeros(n, dtype=int))
+    return out
 
 
 def _signed_sums(vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -430,9 +468,9 @@ def place_tires(vehicle: Vehicle, speed_mps: float, tires: list[dict], positions
     slot_axle = np.array([axles.index(sl.axle) for sl in slots])
     # a plan at zero is searched for only where the relaxation allows one (a set whose ply steer
     # points one way cannot cancel: its optimum is away from zero and the program proves it fast)
-    y = _near_zero_plan(coef.reshape(2, n, A, 2), const, slot_axle, seed) if relaxed() <= 0.5 * TIE_M else None
+    y = _near_zero_plan(coef.reshape(2, n, A, 2), const, slot_axle, seed) if relaxed() <= ZERO_M else None
     if y is not None:
-        # |O| <= TIE_M / 2 and |trim steer| <= TIE_GAP_RAD / 2: optimal for both programs, as no
+        # |O| <= ZERO_M and |trim steer| <= ZERO_RAD: optimal for both programs, as no
         # plan does better than 0 (the plan lies in every tie band, whatever the least |O| is)
         bound, o_first = 0.0, abs(const[0] + coef[0] @ y.ravel())
     else:
