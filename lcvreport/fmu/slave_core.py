@@ -160,10 +160,11 @@ class SlaveCore:
 
     def get_real(self, vrs):
         try:
-            if self._stepped and self._out_slice is not None and vrs == self._last_get:
+            same = type(vrs) is list and vrs == self._last_get   # (a list: an array would compare elementwise)
+            if same and self._stepped and self._out_slice is not None:
                 return self.engine.stepped_outputs[self._out_slice].tolist()     # outputs only, after a step
             values = self._values if self._values is not None else self._current_values()
-            if vrs == self._last_get:           # the host asks for what it asked for last time
+            if same:                            # the host asks for what it asked for last time
                 if self._bad_vrs and not self._bad_vrs.isdisjoint(vrs):
                     self._error(self.engine.output_error or "an output is not finite")
                 return values[self._last_slice] if self._last_slice is not None else [values[vr] for vr in vrs]
