@@ -97,26 +97,11 @@ def main() -> None:
 
 def native_step_us(vehicle, model: str) -> float:
     """Per-step time [us] of the vehicle's native FMU of ``model`` in tests/c_host.c (best of REPEATS)."""
-    import xml.etree.ElementTree as ET
-    import zipfile
+    from fmu_step import c_host_us_per_step          # benchmarks/: the C-host timing, one definition
     from lcvreport.fmu.build import build_vehicle_fmus
     with tempfile.TemporaryDirectory() as tmp:
         fmu = build_vehicle_fmus(vehicle, tmp, kind="native", model=model)[0]
-        exe = Path(tmp) / "c_host"
-        subprocess.run(["gcc", "-O2", "-std=c99", "-o", str(exe), str(ROOT / "tests" / "c_host.c"), "-ldl"],
-                       check=True)
-        unzipped = Path(tmp) / "fmu"
-        zipfile.ZipFile(fmu).extractall(unzipped)
-        root = ET.parse(unzipped / "modelDescription.xml").getroot()
-        vr = {sv.get("name"): sv.get("valueReference") for sv in root.iter("ScalarVariable")}
-        rear = f"P_{vehicle.axles[-1].name}"
-        out = float("inf")
-        for _ in range(REPEATS):
-            p = subprocess.run([str(exe), str(unzipped), f"{vehicle.name}Native", root.get("guid"), "bench",
-                                str(int(1e6)), "0.001", vr[rear], vr["Y_rear"]], check=True, capture_output=True,
-                               text=True)
-            out = min(out, *(float(x.split()[1]) for x in p.stdout.splitlines() if x.startswith("us_per_step")))
-        return out
+        return c_host_us_per_step(fmu, f"{vehicle.name}Native", f"P_{vehicle.axles[-1].name}", "Y_rear")
 
 
 if __name__ == "__main__":
