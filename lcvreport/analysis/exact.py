@@ -40,6 +40,7 @@ from ..manoeuvres.steer import SteerInput
 from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.outputs import rear_end_weights
+from ..util.numerics import expm as _expm_checked
 from ..util.threads import one_blas_thread
 from .discretize import augmented_state_matrix
 from .extrema import _hermite_roots, _quintic, _scan
@@ -201,7 +202,6 @@ class ManoeuvreResponse:
 
     def value_at(self, name: str, t: float) -> float:
         """The exact value of signal ``name`` at time ``t`` [s] (within the sampled span)."""
-        from scipy.linalg import expm
         j = self._index(name)
         if not self.time[0] <= t <= self.time[-1]:
             raise ValueError(f"t = {t} s is outside the response [{self.time[0]}, {self.time[-1]}] s")
@@ -268,6 +268,16 @@ def _steer_axle_maps(vehicle, speed_mps, tire_scale, model: str = "yaw_plane"):
 
 
 @one_blas_thread
+def expm(A: np.ndarray) -> np.ndarray:
+    """The matrix exponential (:func:`lcvreport.util.numerics.expm`: Al-Mohy & Higham 2009, the
+    algorithm of scipy's, without importing scipy.linalg -- 0.2 s of every command's start-up); NaN
+    where it is not finite (an unstable run's overflow: the callers refuse non-finite responses)."""
+    try:
+        return _expm_checked(A)
+    except FloatingPointError:
+        return np.full(np.shape(A), np.nan)
+
+
 def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float, dt: float,
              F: np.ndarray | None = None, tire_scale: float = 1.0, t_start: float = 0.0,
              state: np.ndarray | None = None, model: str = "yaw_plane",
@@ -373,7 +383,6 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
     segments = []
     t_grid = t_start + np.arange(n_steps + 1) * dt
     z_state = np.zeros(m) if state is None else np.asarray(state, dtype=float)   # [x, psi1, Y1]
-    from scipy.linalg import expm
     for piece in steer.pieces:
         if piece.t0 > t_end + 1e-12:
             break
