@@ -203,7 +203,8 @@ class LCVEngine:
         self._out = np.zeros(n_out)
         self._F = np.zeros((n_out, rows))
         self._F[:, m:m + n_out] = np.eye(n_out)
-        self._F[:, m + n_out:] = self._W
+        if self._has_y:
+            self._F[:, m + n_out:] = self._W
 
     def maps(self) -> dict:
         """The engine's input and output maps (what the C FMU's generated data holds):
