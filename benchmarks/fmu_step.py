@@ -113,22 +113,31 @@ def c_host_us_per_step(fmu: Path, identifier: str = "LCVNative", vr_in: str = "P
     """Per-step time [us] of a native FMU (model identifier ``identifier``) in the C host
     (tests/c_host.c): 10^6 steps of 1 ms with the input ``vr_in`` at 1000 and the output ``vr_out``
     read every step, best of REPEATS."""
+    return min(c_host_rounds([(fmu, identifier, vr_in, vr_out)])[0])
+
+
+def c_host_rounds(fmus: list[tuple], rounds: int = REPEATS) -> list[list[float]]:
+    """Per-step times [us] of native FMUs ``(path, identifier, vr_in, vr_out)`` in the C host,
+    ``rounds`` rounds each running every FMU once, back to back (so a round's ratios are immune to
+    the machine's slow drifts): one list of times per FMU."""
     with tempfile.TemporaryDirectory() as tmp:
         exe = Path(tmp) / "c_host"
         subprocess.run(["gcc", "-O2", "-std=c99", "-o", str(exe), str(ROOT / "tests" / "c_host.c"), "-ldl"],
                        check=True)
-        unzipped = Path(tmp) / "fmu"
-        zipfile.ZipFile(fmu).extractall(unzipped)
-        root = ET.parse(unzipped / "modelDescription.xml").getroot()
-        vr = {sv.get("name"): sv.get("valueReference") for sv in root.iter("ScalarVariable")}
-        best = float("inf")
-        for _ in range(REPEATS):
-            p = subprocess.run([str(exe), str(unzipped), identifier, root.get("guid"), "bench", str(int(1e6)), "0.001",
-                                vr[vr_in], vr[vr_out]], check=True, capture_output=True, text=True)
-            for line in p.stdout.splitlines():
-                if line.startswith("us_per_step"):
-                    best = min(best, float(line.split()[1]))
-    return best
+        commands = []
+        for k, (fmu, identifier, vr_in, vr_out) in enumerate(fmus):
+            unzipped = Path(tmp) / f"fmu{k}"
+            zipfile.ZipFile(fmu).extractall(unzipped)
+            root = ET.parse(unzipped / "modelDescription.xml").getroot()
+            vr = {sv.get("name"): sv.get("valueReference") for sv in root.iter("ScalarVariable")}
+            commands.append([str(exe), str(unzipped), identifier, root.get("guid"), "bench", str(int(1e6)), "0.001",
+                             vr[vr_in], vr[vr_out]])
+        times = [[] for _ in fmus]
+        for _ in range(rounds):
+            for k, cmd in enumerate(commands):
+                p = subprocess.run(cmd, check=True, capture_output=True, text=True)
+                times[k] += [float(line.split()[1]) for line in p.stdout.splitlines() if line.startswith("us_per_step")]
+    return times
 
 
 def main() -> None:
