@@ -249,9 +249,12 @@ def test_the_modeldescription_declares_the_roll_outputs_dependencies(roll_fmus):
     svs = list(root.iter("ScalarVariable"))
     index = {sv.get("name"): k + 1 for k, sv in enumerate(svs)}
     deps = {int(u.get("index")): u.get("dependencies") for u in root.find("ModelStructure/Outputs")}
+    states = {index[n] for n in ("phi1", "p1", "v1")}
     for name in ("ltr1", "dFz_steer", "as2"):
-        listed = deps[index[name]]
-        assert listed is None or str(index["delta"]) in listed.split(), (name, listed)
+        listed = set(int(k) for k in (deps[index[name]] or "").split())
+        assert index["delta"] in listed and index["P_steer"] in listed, (name, listed)   # feedthrough
+        assert states <= listed, (name, listed)                                          # and the state
+    assert index["delta"] not in set(int(k) for k in deps[index["phi1"]].split())        # a state: none
 
 
 @pytest.mark.parametrize("name", NAMES)
