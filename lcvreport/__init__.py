@@ -52,7 +52,8 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``frequency``        G(j w) from the steer to every unit's acceleration, RA(f)
     ``exact``            exact response to steer inputs (augmented exponential)
     ``extrema``          extrema between samples (Hermite), the doubling scan
-    ``response``         TimeResponse, simulate, step_response (exact)
+    ``time_response``    TimeResponse: every exact response, signals by name and unit, extrema, tables, plot
+    ``response``         simulate, step_response: inputs held over intervals (exact)
     ``discretize``       exact zero-order-hold discretization, its cache
     ``modal``            modal superposition, exact and the thesis' method
     ``statespace``       named state space; to_statespace (python-control)
@@ -164,7 +165,7 @@ _API = {
     "ResidualLoads": "model.yaw_plane.loads", "one_percent_rule": "model.yaw_plane.loads", "load_vector": "model.yaw_plane.loads",
     "Modes": "analysis.modes", "modes": "analysis.modes", "eigenvalues": "analysis.modes",
     "steady_state": "analysis.steady",
-    "TimeResponse": "analysis.response", "simulate": "analysis.response", "step_response": "analysis.response",
+    "TimeResponse": "analysis.time_response", "simulate": "analysis.response", "step_response": "analysis.response",
     "to_statespace": "analysis.statespace",
     "measure_set": "measures.measure_set", "rearward_amplification": "analysis.frequency",
     "critical_speed": "measures.stability", "least_damping": "measures.stability", "single_sine": "measures.amplification",

@@ -29,7 +29,8 @@ from ..model.vehicle import Vehicle
 from ..model.yaw_plane.equations import system_coefficients
 from ..model.yaw_plane.loads import ResidualLoads, load_vector
 from .discretize import Discretizer, augmented_state_matrix
-from .response import TimeResponse
+from .response import held_response
+from .time_response import TimeResponse
 
 
 @dataclass(frozen=True)
@@ -83,9 +84,8 @@ def steer_feedback(vehicle: Vehicle, speed_mps: float, gains: tuple[float, float
         z[k + 1] = Ad @ z[k] + Gd @ (F + b * delta[k])
     delta[n_steps] = steer(n_steps)
     t = np.arange(n_steps + 1) * h
-    forces = F[None, :] + delta[:, None] * b[None, :]
-    response = TimeResponse(t, z, vehicle, np.full(t.size, float(speed_mps)), forces, float(tire_scale),
-                            label="steer feedback")
+    response = held_response(vehicle, t, z, np.full(t.size, float(speed_mps)), np.broadcast_to(F, (t.size, n)),
+                             tire_scale, delta_rad=delta, label="steer feedback")
     return SteerFeedback(response, delta)
 
 

@@ -19,8 +19,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.linear import linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import SystemCoefficients, system_coefficients
+from ..model.yaw_plane.equations import SystemCoefficients
 from ..util.cache import LRUCache
 
 #: names of the two states appended to the model state for global position
@@ -94,6 +95,7 @@ class Discretizer:
 
     vehicle: Vehicle
     maxsize: int = 64
+    model: str = "yaw_plane"
     _cache: LRUCache = field(default=None, repr=False)
 
     def __call__(self, speed_mps: float, h: float, tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -102,7 +104,7 @@ class Discretizer:
             self._cache = LRUCache(self.maxsize)
 
         def compute():
-            A, G = augmented_state_matrix(system_coefficients(self.vehicle), speed_mps, tire_scale)
+            A, G = augmented_state_matrix(linear_model(self.vehicle, self.model), speed_mps, tire_scale)
             out = discretize(A, G, h)
             for arr in out:
                 arr.setflags(write=False)

@@ -1,11 +1,9 @@
-"""Forced response: exact for inputs held constant over each interval (zero-order hold).
-
-:func:`simulate` steps ``z = [x, psi1, Y1]`` through the exact discretization of
-:mod:`lcvreport.analysis.discretize` for any (also uneven) time grid, with the speed
-changing between intervals; :func:`step_response` is the thesis' step input from
-rest; :func:`iter_step_response` yields the samples one at a time (constant memory,
-what ``lcv simulate`` streams).  :class:`TimeResponse` reads signals by name and
-plots itself.  SI throughout.
+"""Runs with inputs held over each interval (zero-order hold), exact: :func:`simulate` (any time
+grid, the speed changing between intervals, a steer angle optionally), :func:`step_response`
+(the thesis' step input from rest) and :func:`iter_step_response` (the samples one at a time,
+constant memory); :class:`OutputMap`, the rows of every signal over a piece's state, which the
+manoeuvres of :mod:`lcvreport.analysis.exact` share.  Each returns the package's one
+:class:`~lcvreport.analysis.time_response.TimeResponse`.  SI throughout.
 
 Examples
 --------
@@ -14,115 +12,195 @@ Examples
 >>> r = step_response(v, 22.352, load_vector(v, one_percent_rule(v, ["trailer3"])), t_end=10.0)
 >>> r["y6"].shape, round(float(r["y6"][-1]), 4)        # rear of trailer 3 [m]
 ((1001,), 0.0117)
+>>> r.units()["ay2"], r.columns()[:3]
+('m/s^2', ['time_s', 'v1_m_per_s', 'r1_rad_per_s'])
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
 from typing import Iterator
 
 import numpy as np
 
 from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import system_coefficients
-from ..model.yaw_plane.outputs import rear_end_global, rear_offsets
 from ..ranges import RANGES, RangeError
-from .discretize import GLOBAL_STATES, Discretizer
+from .discretize import GLOBAL_STATES, Discretizer, augmented_state_matrix
+from .time_response import Segment, TimeResponse
 
 
-@dataclass(frozen=True)
-class TimeResponse:
-    """Time histories of one simulation, read by name (SI).
+class OutputMap:
+    """Every signal of a response of ``model`` at one speed as a row over ``z = [x, psi1, Y1, xi,
+    1]``: the steer (when known), the states, psi1, Y1, every unit's ``ay`` (its CG), ``a_steer``
+    (the frontmost steered axle's centre), ``Y_<axle>`` (every axle centre's global lateral
+    position), ``Y_rear`` (the last unit's rear end), the model's further outputs
+    (:meth:`~lcvreport.model.linear.LinearModel.extra_signals`), and hidden rows for the rear
+    offsets ``y2..yN``.
 
-    Attributes
+    Parameters
     ----------
-    time : numpy.ndarray, shape (K,)
-        [s]
-    states : numpy.ndarray, shape (K, 2N+2)
-        ``[v1 (m/s), r1..rN (rad/s), thetaA.. (rad), psi1 (rad), Y1 (m)]``.
-    vehicle : Vehicle
-    speed_mps : numpy.ndarray, shape (K,)
-        Speed from each sample on (the last sample: the last interval's) [m/s].
-    forces : numpy.ndarray, shape (K, 2N)
-        Generalized force held from each sample on (SI), for the accelerations.
-    tire_scale : float
-    label : str
+    co : LinearModel
+    speed_mps, tire_scale : float
+    axle_force_N : numpy.ndarray, optional
+        Each axle's constant lateral tire force of the residual sources [N] (the load transfers).
+    steer_known : bool
+        Whether the pieces give the steer as a row (``d_row``); without it the response has no
+        ``delta`` signal and F is the whole forcing.
     """
 
-    time: np.ndarray
-    states: np.ndarray
-    vehicle: Vehicle
-    speed_mps: np.ndarray
-    forces: np.ndarray
-    tire_scale: float = 1.0
-    label: str = ""
+    def __init__(self, co, speed_mps: float, tire_scale: float, axle_force_N: np.ndarray | None = None,
+                 steer_known: bool = True):
+        vehicle = co.vehicle
+        u = float(speed_mps)
+        n, nu = co.n_states, vehicle.n_units
+        self.n, self.nu, self.m, self.u = n, nu, n + 2, u
+        self.steer_known = steer_known
+        Ca, Da = co.acceleration_maps(u, tire_scale)
+        self.V_ay = np.zeros((nu, n + 2))
+        self.V_ay[:, :n] = Ca
+        self.Da = Da
+        self.da = Da @ co.B_delta(tire_scale)
+        self.xs = steered_point(vehicle) if vehicle.steered_axles else None
+        Y_rows, Y_names = [], []
+        for i, unit in enumerate(vehicle.units):
+            for a in unit.axles:
+                Y_rows.append(co.point_lateral_row(i, a.x_m))
+                Y_names.append(f"Y_{a.name}")
+        Y_rows.append(co.point_lateral_row(nu - 1, vehicle.rear_end_x_m(nu - 1)))
+        Y_names.append("Y_rear")
+        self.Y_rows = np.array(Y_rows)
+        ex_names, self.EX, self.EXD, self.ED, EO = co.extra_signals(u, tire_scale)
+        self.ex_const = EO @ (np.zeros(len(vehicle.axles)) if axle_force_N is None
+                              else np.asarray(axle_force_N, float))
+        self.cum = co.heading_rows()
+        roll_rows = co.roll_offset_rows()
+        self.roll_rows = roll_rows
+        hidden_roll = [] if roll_rows is None else [f"Roff{k + 2}" for k in range(nu - 1)]
+        self.names = tuple((["delta"] if steer_known else []) + list(co.state_names) + list(GLOBAL_STATES) +
+                           [f"ay{i + 1}" for i in range(nu)] + ["a_steer"] + Y_names + list(ex_names) +
+                           [f"Theta{k + 2}" for k in range(nu - 1)] + hidden_roll)
 
-    @property
-    def names(self) -> tuple[str, ...]:
-        """State names, model order then psi1, Y1."""
-        return linear_model(self.vehicle).state_names + GLOBAL_STATES
+    def rows(self, Mz: np.ndarray, d_row: np.ndarray | None, F: np.ndarray) -> np.ndarray:
+        """The rows of every signal (``names``) for a piece with dynamics ``Mz``, steer row
+        ``d_row`` (delta = d_row . z) and constant generalized force ``F`` beside the steer (SI)."""
+        n, nu, m = self.n, self.nu, self.m
+        dim = Mz.shape[0]
+        C = np.zeros((len(self.names), dim))
+        r0 = 0
+        if self.steer_known:
+            C[0] = d_row
+            r0 = 1
+        C[r0:r0 + m, :m] = np.eye(m)
+        r0 += m
+        C[r0:r0 + nu, :m] = self.V_ay
+        if self.steer_known:
+            C[r0:r0 + nu] += np.outer(self.da, d_row)
+        C[r0:r0 + nu, -1] += self.Da @ F
+        r0 += nu
+        if self.xs is not None:
+            # a_s = v1' + x_s r1' + u r1: from the state derivative
+            C[r0] = Mz[0] + self.xs * Mz[1]
+            C[r0, 1] += self.u
+        r0 += 1
+        ny = len(self.Y_rows)
+        C[r0:r0 + ny, :m] = self.Y_rows
+        r0 += ny
+        ne = len(self.ex_const)
+        if ne:
+            # y = X x + XD x' + D delta + O F_y0, x' from the augmented dynamics' first n rows
+            C[r0:r0 + ne, :n] = self.EX
+            C[r0:r0 + ne] += self.EXD @ Mz[:n]
+            if self.steer_known:
+                C[r0:r0 + ne] += np.outer(self.ED, d_row)
+            C[r0:r0 + ne, -1] += self.ex_const
+        r0 += ne
+        C[r0:r0 + nu - 1, :m] = self.cum
+        if self.roll_rows is not None:
+            C[r0 + nu - 1:r0 + 2 * (nu - 1), :n] = self.roll_rows
+        return C
 
-    @property
-    def signal_names(self) -> tuple[str, ...]:
-        """Every signal :meth:`__getitem__` knows."""
-        n = self.vehicle.n_units
-        return self.names + tuple(f"y{k}" for k in range(2, n + 1)) + ("Y_rear",) + tuple(
-            f"ay{i}" for i in range(1, n + 1))
+class ManoeuvreError(ValueError):
+    """A manoeuvre the vehicle cannot perform (no steered axle; an unstable inverse system)."""
 
-    def __getitem__(self, name: str) -> np.ndarray:
-        """Signal by name: a state, ``y2``..``yN`` [m], ``Y_rear`` [m] or ``ay1``..``ayN`` [m/s^2]."""
-        if name in self.names:
-            return self.states[:, self.names.index(name)]
-        n = self.vehicle.n_units
-        if name.startswith("y") and name[1:].isdigit() and 2 <= int(name[1:]) <= n:
-            return self.rear_offsets[:, int(name[1:]) - 2]
-        if name == "Y_rear":
-            return rear_end_global(self.vehicle, self["psi1"], self["Y1"], self.theta)
-        if name.startswith("ay") and name[2:].isdigit() and 1 <= int(name[2:]) <= n:
-            return self.lateral_acceleration[:, int(name[2:]) - 1]
-        raise KeyError(f"unknown signal {name!r}; valid: {', '.join(self.signal_names)}")
 
-    @property
-    def theta(self) -> np.ndarray:
-        """Articulation angles [rad], shape (K, N-1)."""
-        n = self.vehicle.n_units
-        return self.states[:, n + 1:2 * n]
+def steered_point(vehicle: Vehicle) -> float:
+    """Signed x [m] of the frontmost steered axle on the first unit."""
+    if not vehicle.steered_axles:
+        raise ManoeuvreError(f"{vehicle.name} has no steered axle: no steer input to apply")
+    return max(a.x_m for a in vehicle.steered_axles)
 
-    @property
-    def rear_offsets(self) -> np.ndarray:
-        """y2..yN [m] of eq. 4.42-4.46, shape (K, N-1)."""
-        return rear_offsets(self.vehicle, self.theta)
+# ---------------------------------------------------------------------------- held inputs
+def held_response(vehicle: Vehicle, time: np.ndarray, Z: np.ndarray, speed_mps: np.ndarray, forces: np.ndarray,
+                  tire_scale: float = 1.0, delta_rad: np.ndarray | None = None, model: str = "yaw_plane",
+                  axle_force_N: np.ndarray | None = None, label: str = "") -> TimeResponse:
+    """The :class:`TimeResponse` of a run whose inputs are held from each sample on, from its
+    samples ``Z`` (``[x, psi1, Y1]`` at every time point, computed by the caller exactly): the
+    samples with the same speed, force, steer and step make one piece each.
 
-    @property
-    def lateral_acceleration(self) -> np.ndarray:
-        """a_i = v_i' + u r_i of every unit's CG [m/s^2], shape (K, N) (docs/measures.md)."""
-        co = system_coefficients(self.vehicle)
-        n2 = linear_model(self.vehicle).n_states
-        out = np.empty((self.time.size, self.vehicle.n_units))
-        for u in np.unique(self.speed_mps):
-            sel = self.speed_mps == u
-            Ca, Da = co.acceleration_maps(float(u), self.tire_scale)
-            out[sel] = self.states[sel, :n2] @ Ca.T + self.forces[sel] @ Da.T
-        return out
-
-    def to_rows(self, names: list[str] | None = None) -> list[dict]:
-        """Rows ``{"time_s": t, name: value ...}`` for tables and CSV."""
-        names = list(names or self.signal_names)
-        cols = {n: self[n] for n in names}
-        return [{"time_s": float(t), **{n: float(cols[n][k]) for n in names}} for k, t in enumerate(self.time)]
-
-    def plot(self, signals: list[str] | None = None, ax=None, **style):
-        """Plot signals against time (a :class:`matplotlib.figure.Figure`).
-
-        Parameters
-        ----------
-        signals : list of str
-            Signal names (default: the rear offsets y2..yN).
-        ax : matplotlib Axes, optional
-        style : keyword arguments for ``Axes.plot``.
-        """
-        from ..plotting.time import plot_time_response
-        return plot_time_response(self, signals, ax=ax, **style)
+    Parameters
+    ----------
+    vehicle : Vehicle
+    time : numpy.ndarray, shape (K,)
+        [s]
+    Z : numpy.ndarray, shape (K, n + 2)
+    speed_mps : numpy.ndarray, shape (K,)
+        Forward speed held from each sample on [m/s] (the last: at the last sample).
+    forces : numpy.ndarray, shape (K, n)
+        Generalized force held from each sample on, beside the steer, SI.
+    tire_scale : float
+    delta_rad : numpy.ndarray, shape (K,), optional
+        The steer held from each sample on [rad] (it enters as ``B_delta * delta``); without it
+        the response has no ``delta`` signal and ``forces`` are the whole forcing.  The outputs
+        with a direct feed-through (``ay``, ``a_steer``, the load transfers) at a sample take the
+        input held from it on.
+    model : str
+    axle_force_N : numpy.ndarray, optional
+        Each axle's constant lateral tire force of the residual sources [N].
+    label : str
+    """
+    co = linear_model(vehicle, model)
+    n = co.n_states
+    m = n + 2
+    t = np.asarray(time, dtype=float)
+    u = np.asarray(speed_mps, dtype=float)
+    f = np.asarray(forces, dtype=float)
+    d = None if delta_rad is None else np.asarray(delta_rad, dtype=float)
+    K = t.size
+    h = np.diff(t)
+    # pieces: maximal runs of samples with the same speed, force, steer and step (to rounding)
+    starts = [0]
+    for i in range(1, K):
+        same = (u[i] == u[i - 1] and np.array_equal(f[i], f[i - 1]) and (d is None or d[i] == d[i - 1])
+                and (i == K - 1 or abs(h[i] - h[i - 1]) <= 1e-9 * h[i - 1]))
+        if not same:
+            starts.append(i)
+    starts.append(K)
+    maps = {}
+    segments = []
+    Zaug = np.column_stack([Z, np.ones(K)])
+    row_names = None
+    for i0, i1 in zip(starts[:-1], starts[1:]):                       # samples i0..i1-1
+        if float(u[i0]) not in maps:
+            maps[float(u[i0])] = (augmented_state_matrix(co, u[i0], tire_scale),
+                                  OutputMap(co, u[i0], tire_scale, axle_force_N, steer_known=d is not None))
+        (Aa, Ga), omap = maps[float(u[i0])]
+        total = f[i0] if d is None else f[i0] + co.B_delta(tire_scale) * d[i0]
+        Mz = np.zeros((m + 1, m + 1))
+        Mz[:m, :m] = Aa
+        Mz[:m, -1] = Ga @ total
+        d_row = None
+        if d is not None:
+            d_row = np.zeros(m + 1)
+            d_row[-1] = d[i0]
+        C = omap.rows(Mz, d_row, f[i0])
+        row_names = omap.names
+        end = i1 < K
+        steps = h[i0:min(i1, K - 1)]
+        seg = Segment(Mz, C, i0, Zaug[i0:i1], float(t[i0]), Zaug[i0], Zaug[i1] if end else None,
+                      float(t[i1]) if end else math.inf, float(steps.mean()) if steps.size else 0.0)
+        segments.append(seg)
+    speed = float(u[0]) if np.all(u == u[0]) else u.copy()
+    return TimeResponse(vehicle, t, row_names, segments, speed, model, float(tire_scale), None, label)
 
 
 def _check_time(time: np.ndarray) -> np.ndarray:
@@ -137,9 +215,15 @@ def _check_time(time: np.ndarray) -> np.ndarray:
     return t
 
 
+def _not_finite() -> FloatingPointError:
+    return FloatingPointError("the response is not finite: the vehicle is unstable at this speed and the "
+                              "time span is too long for its growth")
+
+
 def simulate(vehicle: Vehicle, time: np.ndarray, speed_mps: float | np.ndarray, forces: np.ndarray,
              tire_scale: float = 1.0, initial_state: np.ndarray | None = None,
-             discretizer: Discretizer | None = None, label: str = "") -> TimeResponse:
+             discretizer: Discretizer | None = None, label: str = "", delta_rad: np.ndarray | None = None,
+             model: str = "yaw_plane", axle_force_N: np.ndarray | None = None) -> TimeResponse:
     """Exact response to generalized forces held constant between time points.
 
     Parameters
@@ -149,42 +233,65 @@ def simulate(vehicle: Vehicle, time: np.ndarray, speed_mps: float | np.ndarray, 
         Increasing time points [s]; any spacing.
     speed_mps : float or numpy.ndarray, shape (K-1,)
         Forward speed on each interval [m/s].
-    forces : numpy.ndarray, shape (2N,) or (K-1, 2N)
-        Generalized force on each interval (zero-order hold), SI.  A steer angle delta
-        enters as ``co.B_delta(tire_scale) * delta``.
+    forces : numpy.ndarray, shape (n,) or (K-1, n)
+        Generalized force on each interval (zero-order hold), SI.  A steer angle enters either
+        here as ``co.B_delta(tire_scale) * delta`` or through ``delta_rad``.
     tire_scale : float
-    initial_state : numpy.ndarray, shape (2N+2,), optional
+    initial_state : numpy.ndarray, shape (n+2,), optional
         ``[x, psi1, Y1]`` at ``time[0]``; rest when omitted.
     discretizer : Discretizer, optional
         Reuse a cache across calls.
     label : str
+    delta_rad : float or numpy.ndarray, shape (K-1,), optional
+        The steer angle held on each interval [rad]: the response then has the ``delta``
+        signal, and the model's further outputs (the yaw-roll model's load transfers) count it.
+    model : str
+        The linear model (default the yaw plane).
+    axle_force_N : numpy.ndarray, optional
+        Each axle's constant lateral tire force of the residual sources [N] (load transfers).
 
     Returns
     -------
     TimeResponse
-        States at every time point, exact for the held inputs.
+        Exact at every time point and between them for the held inputs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lcvreport import load_preset, simulate, steady_state, system_coefficients
+    >>> v = load_preset("tractor_semitrailer")
+    >>> r = simulate(v, np.linspace(0.0, 20.0, 201), 24.4444, np.zeros(4), delta_rad=0.01)
+    >>> x_ss = steady_state(v, 24.4444, system_coefficients(v).B_delta() * 0.01)
+    >>> round(float(r["ay1"][-1]), 6), round(24.4444 * float(x_ss[1]), 6)   # the steady turn: a1 = u r1 [m/s^2]
+    (0.467021, 0.467021)
     """
     t = _check_time(time)
     k = t.size - 1
     u = np.broadcast_to(np.asarray(speed_mps, dtype=float), (k,))
     check_speed(u)
     check_tire_scale(tire_scale)
-    n = linear_model(vehicle).n_states
+    n = linear_model(vehicle, model).n_states
     f = np.broadcast_to(np.asarray(forces, dtype=float), (k, n))
-    disc = discretizer or Discretizer(vehicle)
+    d = None if delta_rad is None else np.broadcast_to(np.asarray(delta_rad, dtype=float), (k,))
+    ftot = f if d is None else f + linear_model(vehicle, model).B_delta(tire_scale)[None, :] * d[:, None]
+    disc = discretizer or Discretizer(vehicle, model=model)
     z = np.zeros((t.size, n + 2))
     if initial_state is not None:
         z[0] = initial_state
     h = np.diff(t)
     for i in range(k):
         Ad, Gd = disc(u[i], h[i], tire_scale)
-        z[i + 1] = Ad @ z[i] + Gd @ f[i]
+        z[i + 1] = Ad @ z[i] + Gd @ ftot[i]
     if not np.all(np.isfinite(z)):
-        raise FloatingPointError("the response is not finite: the vehicle is unstable at this speed and the "
-                                 "time span is too long for its growth")
-    u_s = np.concatenate([u, u[-1:]]) if k else np.broadcast_to(np.asarray(speed_mps, dtype=float), (1,)).copy()
-    f_s = np.concatenate([f, f[-1:]]) if k else np.broadcast_to(np.asarray(forces, dtype=float), (1, n)).copy()
-    return TimeResponse(t, z, vehicle, u_s, f_s, float(tire_scale), label)
+        raise _not_finite()
+    if k:      # the inputs from each sample on: the last sample's are the last interval's
+        u, f = np.r_[u, u[-1:]], np.concatenate([f, f[-1:]])
+        d = None if d is None else np.r_[d, d[-1:]]
+    else:
+        u = np.broadcast_to(np.asarray(speed_mps, dtype=float), (1,))
+        f = np.broadcast_to(np.asarray(forces, dtype=float), (1, n))
+        d = None if d is None else np.broadcast_to(np.asarray(delta_rad, dtype=float), (1,))
+    return held_response(vehicle, t, z, u, f, tire_scale, d, model, axle_force_N, label)
 
 
 def step_response(vehicle: Vehicle, speed_mps: float, F: np.ndarray, t_end: float, n_points: int = 1001,
@@ -223,10 +330,9 @@ def step_response(vehicle: Vehicle, speed_mps: float, F: np.ndarray, t_end: floa
     for i in range(t.size - 1):
         z[i + 1] = Ad @ z[i] + b
     if not np.all(np.isfinite(z)):
-        raise FloatingPointError("the response is not finite: the vehicle is unstable at this speed and the "
-                                 "time span is too long for its growth")
-    u_s = np.full(t.size, float(speed_mps))
-    return TimeResponse(t, z, vehicle, u_s, np.broadcast_to(f, (t.size, n)).copy(), float(tire_scale), label)
+        raise _not_finite()
+    return held_response(vehicle, t, z, np.full(t.size, float(speed_mps)), np.broadcast_to(f, (t.size, n)),
+                         tire_scale, label=label)
 
 
 def iter_step_response(vehicle: Vehicle, speed_mps: float, F: np.ndarray, dt: float, n_steps: int,

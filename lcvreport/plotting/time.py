@@ -75,48 +75,39 @@ def _margin_labels(ax, lines: list[tuple[str, float]]) -> None:
 
 
 def plot_time_response(response, signals=None, ax=None, **style) -> Figure:
-    """Signals of a :class:`lcvreport.analysis.response.TimeResponse` against time."""
-    names = signals or [f"y{k}" for k in range(2, response.vehicle.n_units + 1)] or ["Y1"]
-    if ax is None:
-        fig, ax = new_figure(PAGE_WIDTH_IN, 3.2)
-    else:
-        fig = ax.figure
-    units = {"v": "m/s", "r": "rad/s", "t": "rad", "y": "m", "Y": "m", "a": "m/s²", "p": "rad"}
-    for i, name in enumerate(names):
-        kw = {"color": PALETTE[i % len(PALETTE)], "lw": 1.1}
-        kw.update(style)
-        ax.plot(response.time, response[name], label=f"{name} [{units.get(name[0], '')}]", **kw)
-    ax.set_xlabel("time [s]")
-    ax.grid(True, lw=0.3)
-    ax.legend(fontsize=SMALL_PT, ncol=2)
-    if response.label:
-        ax.set_title(response.label, fontsize=9)
-    return fig
-
-
-def plot_manoeuvre(response, signals=None, ax=None) -> Figure:
-    """Signals of a :class:`lcvreport.analysis.exact.ManoeuvreResponse` against time
-    (default: every unit's lateral acceleration [m/s^2], the steer angle [deg] dotted on
-    a second axis)."""
+    """Signals of a :class:`lcvreport.analysis.time_response.TimeResponse` against time, each
+    labelled with its unit; where the run knows its steer, the steer angle [deg] dotted on a
+    second axis.  Default signals: every unit's lateral acceleration [m/s^2] where the steer is
+    known, else the rear offsets y2..yN [m] (Y1 of a single unit)."""
     if ax is None:
         fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
     else:
         fig = ax.figure
     v = response.vehicle
-    signals = signals or [f"ay{i + 1}" for i in range(v.n_units)]
+    units = {k: u.replace("^2", "²") for k, u in response.units().items()}
+    steer = "delta" in units
+    signals = list(signals or ([f"ay{i + 1}" for i in range(v.n_units)] if steer else
+                               [f"y{k}" for k in range(2, v.n_units + 1)] or ["Y1"]))
     for i, name in enumerate(signals):
-        ax.plot(response.time, response[name], color=PALETTE[i % len(PALETTE)], lw=1.0, label=name)
-    ax2 = ax.twinx()
-    ax2.plot(response.time, np.degrees(response["delta"]), color="black", lw=0.8, ls=":", label="steer angle")
-    ax2.set_ylabel("steer angle [deg] (dotted)")
-    ax2.tick_params(labelsize=SMALL_PT)
+        kw = {"color": PALETTE[i % len(PALETTE)], "lw": 1.0}
+        kw.update(style)
+        ax.plot(response.time, response[name], label=f"{name} [{units.get(name, '')}]", **kw)
+    handles = ax.get_lines()
+    if steer and "delta" not in signals:
+        ax2 = ax.twinx()
+        ax2.plot(response.time, np.degrees(response["delta"]), color="black", lw=0.8, ls=":", label="steer angle")
+        ax2.set_ylabel("steer angle [deg] (dotted)")
+        ax2.tick_params(labelsize=SMALL_PT)
+        handles = handles + ax2.get_lines()
     ax.set_xlabel("time [s]")
-    units = {"ay": "m/s²", "Y_": "m", "the": "rad", "r": "rad/s", "y": "m"}
-    unit = next((u for k, u in units.items() if signals[0].startswith(k)), "SI")
-    ax.set_ylabel(f"{', '.join(signals[:3])}{' ...' if len(signals) > 3 else ''} [{unit}]")
+    shown = {units.get(name, "") for name in signals}
+    ax.set_ylabel(f"{', '.join(signals[:3])}{' ...' if len(signals) > 3 else ''}"
+                  + (f" [{shown.pop()}]" if len(shown) == 1 else ""))
     ax.grid(True, lw=0.3)
-    ax.legend(handles=ax.get_lines() + ax2.get_lines(), fontsize=SMALL_PT, ncol=4, loc="upper center",
-              bbox_to_anchor=(0.5, -0.18), frameon=False)
+    ax.legend(handles=handles, fontsize=SMALL_PT, ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.18),
+              frameon=False)
+    if response.label:
+        ax.set_title(response.label, fontsize=9)
     return fig
 
 

@@ -1,0 +1,352 @@
+"""The one time response of the package: :class:`TimeResponse`, every exact response sampled,
+with every signal by name and unit.
+
+A response is a chain of pieces (:class:`Segment`); on each, the model, the global position
+(psi1, Y1), the input's generator and a constant 1 form one homogeneous linear system
+``z' = Mz z`` (``z = [x, psi1, Y1, xi, 1]``), so every signal is a row over z (``c . z``) and
+its time derivatives are ``c Mz z`` and ``c Mz^2 z``: the extrema of any signal are located
+between the samples on the continuous response (:mod:`lcvreport.analysis.extrema`: a cubic
+Hermite interpolant of the derivative through its exact values and slopes, O(dt^4), the value
+from a quintic one, O(dt^6)).  The runs that make responses are in
+:mod:`lcvreport.analysis.response` (inputs held over intervals) and
+:mod:`lcvreport.analysis.exact` (continuous steer inputs).
+
+Examples
+--------
+>>> from lcvreport import load_preset
+>>> from lcvreport.analysis.exact import response
+>>> from lcvreport.manoeuvres.steer import sine
+>>> r = response(load_preset("tractor_semitrailer"), 24.4444, sine(0.01, 0.4), t_end=10.0, dt=0.01)
+>>> r["ay2"].shape, r.units()["ay2"], column("ay2")
+((1001,), 'm/s^2', 'ay2_m_per_s2')
+>>> round(float(abs(r["ay2"]).max()), 6), round(r.peak_abs("ay2"), 6)   # sampled; located between samples
+(0.42677, 0.426772)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.linear import linear_model
+from ..model.vehicle import Vehicle
+from ..model.yaw_plane.outputs import rear_end_weights
+from ..util.numerics import expm as _expm_checked
+from ..util.threads import one_blas_thread
+from .discretize import GLOBAL_STATES
+from .extrema import _hermite_roots, _quintic
+
+#: the unit of every signal by the start of its name (first match): (prefix, column suffix, unit)
+SIGNAL_UNITS = (("delta", "rad", "rad"), ("theta", "rad", "rad"), ("psi", "rad", "rad"), ("phi", "rad", "rad"),
+                ("ay", "m_per_s2", "m/s^2"), ("as", "m_per_s2", "m/s^2"), ("a_steer", "m_per_s2", "m/s^2"),
+                ("dFz_", "N", "N"), ("ltr", "", "-"), ("Y", "m", "m"), ("y", "m", "m"),
+                ("v", "m_per_s", "m/s"), ("r", "rad_per_s", "rad/s"), ("p", "rad_per_s", "rad/s"))
+
+
+def signal_unit(name: str) -> str:
+    """The unit of a signal as a person reads it (``"m/s^2"``, ``"rad"``, ``"-"``).
+
+    Examples
+    --------
+    >>> signal_unit("ay2"), signal_unit("dFz_a11"), signal_unit("ltr1")
+    ('m/s^2', 'N', '-')
+    """
+    return next((u for prefix, _s, u in SIGNAL_UNITS if name.startswith(prefix)), "m")
+
+
+def column(name: str) -> str:
+    """The column header of a signal: its name and unit (``phi2_rad``, ``dFz_a1_N``, ``ltr1``).
+
+    Examples
+    --------
+    >>> column("ay2"), column("Y_rear"), column("ltr1")
+    ('ay2_m_per_s2', 'Y_rear_m', 'ltr1')
+    """
+    unit = next((s for prefix, s, _u in SIGNAL_UNITS if name.startswith(prefix)), "m")
+    return f"{name}_{unit}" if unit else name
+
+
+def _is_hidden(name: str) -> bool:
+    """Rows kept for the rear offsets, not signals."""
+    return name.startswith("Theta") or name.startswith("Roff")
+
+
+@one_blas_thread
+def expm(A: np.ndarray) -> np.ndarray:
+    """The matrix exponential (:func:`lcvreport.util.numerics.expm`: Al-Mohy & Higham 2009, the
+    algorithm of scipy's, without importing scipy.linalg -- 0.2 s of every command's start-up); NaN
+    where it is not finite (an unstable run's overflow: the callers refuse non-finite responses)."""
+    try:
+        return _expm_checked(A)
+    except FloatingPointError:
+        return np.full(np.shape(A), np.nan)
+
+
+@dataclass
+class Segment:
+    """One piece of a response: its dynamics ``z' = Mz z``, the signal rows ``C`` over z, its
+    samples ``Z`` (rows: the time points ``k0, k0 + 1, ...`` of the response, spaced ``dt``), and
+    the piece's start ``t0`` and end ``t1`` with z there (``z_end`` None when the response ends
+    inside the piece)."""
+
+    Mz: np.ndarray
+    C: np.ndarray
+    k0: int
+    Z: np.ndarray
+    t0: float
+    z_start: np.ndarray
+    z_end: np.ndarray | None = None
+    t1: float = math.inf
+    dt: float = 0.0
+
+
+@dataclass
+class TimeResponse:
+    """The exact response of one vehicle, sampled, with every signal by name (SI).
+
+    Signals: ``delta`` [rad] (where the run knows the steer), the model's states (``v1`` [m/s],
+    ``r1``.. [rad/s], ``theta..`` [rad]; the yaw-roll model's ``p<i>``, ``phi<i>``), ``psi1``
+    [rad], ``Y1`` [m], ``ay1..ayN`` [m/s^2] (unit CGs), ``a_steer`` [m/s^2] (the steered axle's
+    centre), ``Y_<axle>`` and ``Y_rear`` [m] (global lateral positions, first order), the model's
+    further outputs (``as<i>``, ``dFz_<axle>``, ``ltr<g>``), ``y2..yN`` [m] (rear ends from the
+    tractor axis).  ``r["ay3"]`` or ``r["ay3_m_per_s2"]``; :meth:`extrema` on the continuous
+    response; :meth:`to_pandas`, :meth:`to_rows`, :meth:`plot`.
+
+    Attributes
+    ----------
+    vehicle : Vehicle
+    time : numpy.ndarray, shape (K,)
+        [s]
+    segments : list of Segment
+    speed_mps : float or numpy.ndarray
+        Forward speed [m/s]; per sample, shape (K,), when it changes along the run.
+    model : str
+    tire_scale : float
+    steer : SteerInput or None
+        The continuous steer input of a manoeuvre.
+    label : str
+    """
+
+    vehicle: Vehicle
+    time: np.ndarray
+    row_names: tuple = field(repr=False)
+    segments: list = field(repr=False)
+    speed_mps: float | np.ndarray = 0.0
+    model: str = "yaw_plane"
+    tire_scale: float = 1.0
+    steer: object = None
+    label: str = ""
+
+    # ------------------------------------------------------------------ names and units
+    @property
+    def signal_names(self) -> tuple[str, ...]:
+        """Every signal, in the order of :meth:`columns`."""
+        return tuple(n for n in self.row_names if not _is_hidden(n)) + tuple(
+            f"y{k}" for k in range(2, self.vehicle.n_units + 1))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The states of ``z = [x, psi1, Y1]``: the model's, then psi1, Y1."""
+        return linear_model(self.vehicle, self.model).state_names + GLOBAL_STATES
+
+    def units(self) -> dict:
+        """``{signal: unit}`` as a person reads it (``"m/s^2"``, ``"rad"``, ``"-"``)."""
+        return {n: signal_unit(n) for n in self.signal_names}
+
+    def columns(self) -> list[str]:
+        """Column headers with units (``time_s``, ``ay2_m_per_s2`` ...), in the order of :meth:`matrix`."""
+        return ["time_s"] + [column(n) for n in self.signal_names]
+
+    # ------------------------------------------------------------------ values
+    def __getitem__(self, name: str) -> np.ndarray:
+        """A signal by name or by column header (``"ay2"``, ``"ay2_m_per_s2"``, ``"time_s"``)."""
+        if name == "time_s":
+            return self.time
+        name = self._signal(name)
+        if name.startswith("y") and name[1:].isdigit():
+            return self._rear_offsets()[:, int(name[1:]) - 2]
+        j = self._index(name)
+        return np.concatenate([seg.Z @ seg.C[j] for seg in self.segments])
+
+    def _signal(self, name: str) -> str:
+        if name in self.row_names or (name.startswith("y") and name[1:].isdigit()
+                                      and 2 <= int(name[1:]) <= self.vehicle.n_units):
+            return name
+        for s in self.signal_names:
+            if column(s) == name:
+                return s
+        raise KeyError(f"no signal {name!r}; signals: {', '.join(self.signal_names)}")
+
+    def _index(self, name: str) -> int:
+        try:
+            return self.row_names.index(name)
+        except ValueError:
+            raise KeyError(f"no signal {name!r}; signals: {', '.join(self.signal_names)}") from None
+
+    def _rear_offsets(self) -> np.ndarray:
+        Theta = self._hidden("Theta")
+        y = np.sin(Theta) @ rear_end_weights(self.vehicle).T
+        roll = self._hidden("Roff")                  # the yaw-roll model's coupling roll offsets
+        return y + roll if roll.shape[1] else y
+
+    def _hidden(self, prefix: str) -> np.ndarray:
+        rows = [j for j, n in enumerate(self.row_names) if n.startswith(prefix)]
+        if not rows:
+            return np.zeros((self.time.size, 0))
+        return np.concatenate([seg.Z @ (seg.C[rows].T) for seg in self.segments])
+
+    @property
+    def states(self) -> np.ndarray:
+        """``[x, psi1, Y1]`` at every sample, shape (K, n + 2)."""
+        m = len(self.names)
+        return np.concatenate([seg.Z[:, :m] for seg in self.segments])
+
+    @property
+    def theta(self) -> np.ndarray:
+        """Articulation angles [rad], shape (K, N-1)."""
+        names = [n for n in self.names if n.startswith("theta")]
+        return self.states[:, [self.names.index(n) for n in names]]
+
+    @property
+    def rear_offsets(self) -> np.ndarray:
+        """y2..yN [m] (docs/model.md), shape (K, N-1)."""
+        return self._rear_offsets()
+
+    @property
+    def lateral_acceleration(self) -> np.ndarray:
+        """a_i = v_i' + u r_i of every unit's CG [m/s^2], shape (K, N) (docs/measures.md)."""
+        return np.column_stack([self[f"ay{i + 1}"] for i in range(self.vehicle.n_units)])
+
+    def final_state(self) -> np.ndarray:
+        """[x, psi1, Y1] at the last sample (to continue a run in chunks)."""
+        return self.segments[-1].Z[-1, :len(self.names)].copy()
+
+    def matrix(self) -> np.ndarray:
+        """Every signal at every sample, columns as :meth:`columns`."""
+        keep = [j for j, n in enumerate(self.row_names) if not _is_hidden(n)]
+        with np.errstate(over="ignore", invalid="ignore"):     # an overflowed (unstable) run: callers refuse it
+            lin = np.concatenate([seg.Z @ seg.C[keep].T for seg in self.segments])
+            return np.column_stack([self.time, lin, self._rear_offsets()])
+
+    def to_rows(self, names: list[str] | None = None) -> list[dict]:
+        """Rows for a table or CSV: ``time_s`` and the named signals (default all), keyed by
+        column header (``{"time_s": 0.0, "ay2_m_per_s2": ...}``)."""
+        cols = self.columns()
+        M = self.matrix()
+        keep = list(range(len(cols))) if names is None else [0] + [
+            i for i, s in enumerate(self.signal_names, start=1) if s in names or cols[i] in names]
+        return [{cols[i]: float(row[i]) for i in keep} for row in M]
+
+    def to_pandas(self):
+        """The response as a :class:`pandas.DataFrame`, one column per signal with its unit in
+        the header (``time_s``, ``ay2_m_per_s2`` ...); needs pandas (``lcvreport[study]``)."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("to_pandas needs pandas: pip install 'lcvreport[study]'") from None
+        return pd.DataFrame(self.matrix(), columns=self.columns())
+
+    # ------------------------------------------------------------------ the continuous response
+    def extrema(self, name: str, t_from: float = 0.0, t_to: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
+        """Times [s] and values of the local extrema of signal ``name`` in ``[t_from,
+        t_to]`` on the continuous response, plus the values at the ends of that window
+        and at the input's breakpoints (where the derivative may jump)."""
+        return self.extrema_many([name], t_from, t_to)[0]
+
+    def extrema_many(self, names, t_from: float = 0.0, t_to: float = math.inf) -> list:
+        """:meth:`extrema` of several signals at once (one product per piece for all of them):
+        a list of (times, values), in the order of ``names``."""
+        names = [self._signal(n) for n in names]
+        js = [self._index(n) for n in names]
+        K = len(js)
+        times = [[] for _ in js]
+        values = [[] for _ in js]
+        for seg in self.segments:
+            t = self.time[seg.k0:seg.k0 + len(seg.Z)]
+            if t.size == 0:
+                continue
+            c = seg.C[js].T                                   # (dim, K)
+            c1 = seg.Mz.T @ c
+            c2 = seg.Mz.T @ c1
+            dt = seg.dt
+            if t.size > 1:
+                D1 = c1.T @ seg.Z.T                           # the derivatives at the samples: (K, samples)
+                pos = D1 > 0
+                # a sign change of the derivative (one side > 0, the other <= 0: a flat stretch of
+                # zeros is none), in an interval that reaches into the window
+                change = pos[:, :-1] != pos[:, 1:]
+                if t[0] < t_from or t[-1] > t_to:
+                    change &= (t[1:] >= t_from) & (t[:-1] <= t_to)
+                sig, k = np.divmod(np.flatnonzero(change), t.size - 1)   # by signal, then by time
+                if k.size:
+                    k1 = k + 1
+                    W = np.concatenate([c, c2], axis=1)       # values and second derivatives, at the ends only
+                    Ya, Yb = seg.Z[k] @ W, seg.Z[k1] @ W
+                    rows = np.arange(k.size)
+                    ya, sa, yb, sb = Ya[rows, sig], Ya[rows, K + sig], Yb[rows, sig], Yb[rows, K + sig]
+                    da, db = D1[sig, k], D1[sig, k1]
+                    tau = _hermite_roots(da, sa, db, sb, dt)
+                    tk = t[k] + tau * dt
+                    val = _quintic(ya, da, sa, yb, db, sb, dt, tau)
+                    keep = (tk >= t_from) & (tk <= t_to)
+                    sig, tk, val = sig[keep], tk[keep], val[keep]
+                    bounds = np.searchsorted(sig, np.arange(K + 1))
+                    for s_ in range(K):
+                        lo, hi = bounds[s_], bounds[s_ + 1]
+                        if hi > lo:
+                            times[s_].extend(tk[lo:hi].tolist())
+                            values[s_].extend(val[lo:hi].tolist())
+            # the piece's own ends
+            for tb, zb in ((seg.t0, seg.z_start), (seg.t1, seg.z_end)):
+                if zb is not None and t_from <= tb <= t_to and math.isfinite(tb):
+                    vb = zb @ c
+                    for s in range(K):
+                        times[s].append(tb)
+                        values[s].append(float(vb[s]))
+        out = []
+        for s, name in enumerate(names):                      # the ends of the window
+            for tb in (t_from, min(t_to, self.time[-1])):
+                if self.time[0] <= tb <= self.time[-1]:
+                    times[s].append(tb)
+                    values[s].append(self.value_at(name, tb))
+            order = np.argsort(times[s])
+            out.append((np.asarray(times[s])[order], np.asarray(values[s])[order]))
+        return out
+
+    def value_at(self, name: str, t: float) -> float:
+        """The exact value of signal ``name`` at time ``t`` [s] (within the sampled span)."""
+        j = self._index(self._signal(name))
+        if not self.time[0] <= t <= self.time[-1]:
+            raise ValueError(f"t = {t} s is outside the response [{self.time[0]}, {self.time[-1]}] s")
+        for seg in self.segments:
+            if seg.t0 <= t < seg.t1 or seg is self.segments[-1]:
+                ts = self.time[seg.k0:seg.k0 + len(seg.Z)]
+                k = int(np.searchsorted(ts, t, side="right")) - 1
+                t_base, z = (seg.t0, seg.z_start) if k < 0 else (ts[k], seg.Z[k])
+                if t == t_base:                         # a sample (or the piece's start): no exponential
+                    return float(seg.C[j] @ z)
+                return float(seg.C[j] @ expm(seg.Mz * (t - t_base)) @ z)
+        raise ValueError(f"t = {t} s is outside the response")  # pragma: no cover
+
+    def peak_abs(self, name: str, t_from: float = 0.0, t_to: float = math.inf) -> float:
+        """max |signal| over ``[t_from, t_to]`` on the continuous response."""
+        _t, v = self.extrema(name, t_from, t_to)
+        return float(np.abs(v).max())
+
+    def peaks_abs(self, names, t_from: float = 0.0, t_to: float = math.inf) -> np.ndarray:
+        """:meth:`peak_abs` of several signals at once."""
+        return np.array([float(np.abs(v).max()) for _t, v in self.extrema_many(names, t_from, t_to)])
+
+    def plot(self, signals: list[str] | None = None, ax=None, **style):
+        """Plot signals against time (a :class:`matplotlib.figure.Figure`): default every unit's
+        ``ay`` with the steer on a second axis where the run knows it, else the rear offsets.
+
+        Parameters
+        ----------
+        signals : list of str, optional
+        ax : matplotlib Axes, optional
+        style : keyword arguments for ``Axes.plot``.
+        """
+        from ..plotting.time import plot_time_response
+        return plot_time_response(self, signals, ax=ax, **style)
