@@ -110,3 +110,38 @@ def test_step_response_and_feedback_are_time_responses(semi):
     assert r.speed_mps == U
     run = steer_feedback(semi, 22.352, (0.002, 0.2), 0.05, 100, residual_P_N={"11": 1000.0})
     np.testing.assert_array_equal(run.response["delta"], run.delta)      # held from each sample on
+
+
+@pytest.mark.parametrize("dt", [0.1, 0.3])
+def test_extrema_where_a_piece_ends_between_samples(semi, dt):
+    """The single sine at 0.4 Hz ends at 2.5 s; on a 0.1 s grid the last sample of the sine's
+    piece is 2.4 s and the peak of ay2 lies between it and the piece's end (on a 0.3 s grid the
+    piece ends between 2.4 and 2.7 s).  The peak is found there (it was missed: only the
+    piece's end value, 0.4163 against the true 0.4268, was seen), against Brent's method on the
+    exact value near the largest sample of a 1 ms run."""
+    r = response(semi, U, sine(0.01, 0.4), 9.0, dt)
+    fine = response(semi, U, sine(0.01, 0.4), 9.0, 0.001)
+    ref = _brent_peak(fine, "ay2", fine.time, fine["ay2"])
+    assert r.peak_abs("ay2") == pytest.approx(ref, rel=1e-7)        # O(dt^6) quintic, dt = 0.1-0.3 s
+    t, v = r.extrema("ay2", 2.0, 3.0)
+    k = int(np.argmax(np.abs(v)))
+    assert 2.4 < t[k] < 2.5 and r.value_at("ay2", t[k]) == pytest.approx(v[k], rel=1e-6)
+
+
+def test_a_piece_without_samples_is_scanned(semi):
+    """A pulse of 0.05 s between two samples 0.1 s apart: its piece holds no sample, and was not
+    scanned (the steer's extrema were its zeros at the piece's ends).  Its peak (0.01 rad at 1.045 s)
+    is found; the value is the quintic Hermite interpolant's over the whole half sine (omega h = pi,
+    far outside its asymptotic range: 2 % low), the time is exact by symmetry."""
+    from dataclasses import replace
+
+    from lcvreport.manoeuvres.steer import parse_steer
+    steer = parse_steer("pulse:0.01:0.05")
+    Piece = type(steer.pieces[0])
+    rest = Piece(0.0, 1.02, np.zeros((1, 1)), np.zeros(1), np.ones(1))          # no steer until 1.02 s
+    shifted = replace(steer, pieces=(rest,) + tuple(replace(p, t0=p.t0 + 1.02, t1=p.t1 + 1.02) for p in steer.pieces))
+    r = response(semi, U, shifted, 2.0, 0.1)
+    assert any(len(seg.Z) == 0 for seg in r.segments)
+    t, v = r.extrema("delta")
+    k = int(np.argmax(np.abs(v)))
+    assert v[k] == pytest.approx(0.01, rel=0.02) and t[k] == pytest.approx(1.045, abs=1e-9)

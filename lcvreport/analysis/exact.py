@@ -199,7 +199,7 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
         else:
             Z = np.zeros((0, dim))
             z_end = expm(Mz * (t1 - piece.t0)) @ z0 if math.isfinite(t1) else None
-        segments.append(Segment(Mz, C, ka, Z, piece.t0, z0, z_end, t1, dt))
+        segments.append(Segment(Mz, C, ka, Z, piece.t0, z0, z_end, t1))
         if z_end is None:
             break
         z_state = z_end[:m]

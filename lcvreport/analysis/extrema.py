@@ -12,12 +12,14 @@ import numpy as np
 
 def _hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
     """The roots in [0, 1] of cubic Hermite interpolants of f (values f0, f1 of opposite
-    sign, slopes d0, d1 per unit time over a step h), vectorized: Newton from the secant
-    root, kept inside a bracket that shrinks with every iterate (safeguarded)."""
+    sign, slopes d0, d1 per unit time over a step h, one for all or one each), vectorized:
+    Newton from the secant root, kept inside a bracket that shrinks with every iterate
+    (safeguarded)."""
     f0, d0, f1, d1 = (np.asarray(a, dtype=float) for a in (f0, d0, f1, d1))
     if f0.ndim == 1 and f0.size <= 16:     # the usual few roots: the same iteration on floats, no array overhead
-        return np.array([_hermite_root(*args, float(h)) for args in zip(f0.tolist(), d0.tolist(), f1.tolist(),
-                                                                 d1.tolist())])
+        hs = np.broadcast_to(np.asarray(h, dtype=float), f0.shape).tolist()
+        return np.array([_hermite_root(*args) for args in zip(f0.tolist(), d0.tolist(), f1.tolist(),
+                                                              d1.tolist(), hs)])
     d0, d1 = d0 * h, d1 * h
     a = 2 * f0 - 2 * f1 + d0 + d1
     b = -3 * f0 + 3 * f1 - 2 * d0 - d1

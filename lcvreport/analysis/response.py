@@ -195,9 +195,8 @@ def held_response(vehicle: Vehicle, time: np.ndarray, Z: np.ndarray, speed_mps: 
         C = omap.rows(Mz, d_row, f[i0])
         row_names = omap.names
         end = i1 < K
-        steps = h[i0:min(i1, K - 1)]
         seg = Segment(Mz, C, i0, Zaug[i0:i1], float(t[i0]), Zaug[i0], Zaug[i1] if end else None,
-                      float(t[i1]) if end else math.inf, float(steps.mean()) if steps.size else 0.0)
+                      float(t[i1]) if end else math.inf)
         segments.append(seg)
     speed = float(u[0]) if np.all(u == u[0]) else u.copy()
     return TimeResponse(vehicle, t, row_names, segments, speed, model, float(tire_scale), None, label)

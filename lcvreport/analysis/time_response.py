@@ -86,8 +86,7 @@ def expm(A: np.ndarray) -> np.ndarray:
 @dataclass
 class Segment:
     """One piece of a response: its dynamics ``z' = Mz z``, the signal rows ``C`` over z, its
-    samples ``Z`` (rows: the time points ``k0, k0 + 1, ...`` of the response, spaced ``dt``), and
-    the piece's start ``t0`` and end ``t1`` with z there (``z_end`` None when the response ends
+    samples ``Z`` (rows: the time points ``k0, k0 + 1, ...`` of the response), and the piece's start ``t0`` and end ``t1`` with z there (``z_end`` None when the response ends
     inside the piece)."""
 
     Mz: np.ndarray
@@ -98,7 +97,6 @@ class Segment:
     z_start: np.ndarray
     z_end: np.ndarray | None = None
     t1: float = math.inf
-    dt: float = 0.0
 
 
 @dataclass
@@ -264,14 +262,21 @@ class TimeResponse:
         values = [[] for _ in js]
         for seg in self.segments:
             t = self.time[seg.k0:seg.k0 + len(seg.Z)]
+            Z = seg.Z
+            # the piece's stretches before its first sample and after its last (a piece that starts
+            # or ends between samples) are scanned too, from z at the piece's start and end
+            if seg.z_start is not None and (t.size == 0 or seg.t0 < t[0]):
+                t, Z = np.r_[seg.t0, t], np.vstack([seg.z_start, Z])
+            if seg.z_end is not None and math.isfinite(seg.t1) and (t.size == 0 or seg.t1 > t[-1]):
+                t, Z = np.r_[t, seg.t1], np.vstack([Z, seg.z_end])
             if t.size == 0:
                 continue
             c = seg.C[js].T                                   # (dim, K)
             c1 = seg.Mz.T @ c
             c2 = seg.Mz.T @ c1
-            dt = seg.dt
             if t.size > 1:
-                D1 = c1.T @ seg.Z.T                           # the derivatives at the samples: (K, samples)
+                h = np.diff(t)
+                D1 = c1.T @ Z.T                               # the derivatives at the samples: (K, samples)
                 pos = D1 > 0
                 # a sign change of the derivative (one side > 0, the other <= 0: a flat stretch of
                 # zeros is none), in an interval that reaches into the window
@@ -282,13 +287,13 @@ class TimeResponse:
                 if k.size:
                     k1 = k + 1
                     W = np.concatenate([c, c2], axis=1)       # values and second derivatives, at the ends only
-                    Ya, Yb = seg.Z[k] @ W, seg.Z[k1] @ W
+                    Ya, Yb = Z[k] @ W, Z[k1] @ W
                     rows = np.arange(k.size)
                     ya, sa, yb, sb = Ya[rows, sig], Ya[rows, K + sig], Yb[rows, sig], Yb[rows, K + sig]
                     da, db = D1[sig, k], D1[sig, k1]
-                    tau = _hermite_roots(da, sa, db, sb, dt)
-                    tk = t[k] + tau * dt
-                    val = _quintic(ya, da, sa, yb, db, sb, dt, tau)
+                    tau = _hermite_roots(da, sa, db, sb, h[k])
+                    tk = t[k] + tau * h[k]
+                    val = _quintic(ya, da, sa, yb, db, sb, h[k], tau)
                     keep = (tk >= t_from) & (tk <= t_to)
                     sig, tk, val = sig[keep], tk[keep], val[keep]
                     bounds = np.searchsorted(sig, np.arange(K + 1))
