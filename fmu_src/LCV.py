@@ -1,4 +1,6 @@
-"""The slave module pythonfmu loads from the FMU's resources: the class is
+"""The slave module pythonfmu loads from the FMU's resources (as ``lcv_slave_<hash>.py``: each
+FMU's module has a name of its own, since pythonfmu 0.7.0 imports it by name and takes the
+class from ``sys.modules`` -- a second FMU under the same name ran the first one's class): the class is
 :class:`lcvreport.fmu.slave_fmi2.LCV` of the package bundled next to this file, under a name of
 its own (``lcvreport_fmu_<hash>``, written in by the build where ``lcvreport`` stands
 below), so a Python host that has imported another ``lcvreport`` -- another version, an

@@ -160,7 +160,10 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
         slave_text = (src / "LCV.py").read_text(encoding="utf-8")
         if "from lcvreport.fmu.slave_fmi2 import LCV" not in slave_text:
             raise FmuBuildError("fmu_src/LCV.py lost its import line")
-        files, export = _pythonfmu_build("pythonfmu", itf, tmp, alias, "LCV.py",
+        # the slave module's name is the FMU's own: pythonfmu 0.7.0 imports it by name and takes the class
+        # from sys.modules, so a second FMU whose module had the same name ran the first one's class
+        module = "lcv_slave_" + alias.rsplit("_", 1)[1]
+        files, export = _pythonfmu_build("pythonfmu", itf, tmp, alias, f"{module}.py",
                                          slave_text.replace("from lcvreport.fmu.slave_fmi2 import LCV",
                                                             f"from {alias}.fmu.slave_fmi2 import LCV"),
                                          model_identifier, "linux64")
