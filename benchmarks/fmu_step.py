@@ -9,7 +9,7 @@ A 10 s run at 1 ms steps (10,000 steps) recording every output under
   influence it), and the interface-only twin (LCV's own slave and loader machinery with no
   model: what the guards cost);
 * ``LCVNative.fmu`` (C) and its interface-only twin built from the same interface table
-  with ``fmu_src/c/model_stub.c`` (``build_native_fmu(..., stub=True)``);
+  with ``fmu_src/c/vehicle/model_stub.c`` (``build_native_fmu(..., stub=True)``);
 * ``LCVNative.fmu`` in the plain C host of ``tests/c_host.c`` (10^6 steps).
 
 Runs are alternated and the best of ``REPEATS`` is kept; the LCV / stock ratio is printed

@@ -97,7 +97,8 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``slave_core``       what the Python FMUs compute, FMI calls by value reference onto the engine
     ``slave_fmi2``       the FMI 2.0 slave class: the core behind pythonfmu
     ``slave_fmi3``       the FMI 3.0 slave class: the core behind pythonfmu3
-    ``c_sources``        generated C headers, the source lists, the compiler call
+    ``c_tree``           the C sources: the FMI API per version, the vehicle and driver models, the loaders
+    ``c_sources``        generated C headers, the C files on this machine, the compiler call
     ``package``          documentation, licences, the package copy, the zip
     ``build``            builders of the pythonfmu and the C FMUs (sources in the
                          repository's ``fmu_src/``, installed as ``lcvreport.fmu_src``)

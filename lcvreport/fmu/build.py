@@ -36,9 +36,10 @@ from pathlib import Path
 
 from ..model.vehicle import Vehicle
 from ..model.vehicle_file import dumps_vehicle
-from .c_sources import (C_HEADERS, EXPORT_LIB, NATIVE_SOURCES, STUB_SOURCES, FmuBuildError, _c_string, _compile,
-                        config_data_header, config_header, fmi_header_dir, loader_config_header, source_dir,
-                        vehicle_data_header)
+from .c_sources import (EXPORT_LIB, FmuBuildError, _c_string, _compile, c_files, config_data_header, config_header,
+                        fmi_header_dir, loader_config_header, shipped_sources, source_dir, vehicle_data_header)
+from .c_tree import (INCLUDE_DIRS, LOADER_HEADERS, LOADER_INCLUDE_DIRS, LOADER_SOURCES, NATIVE_HEADERS, NATIVE_SOURCES,
+                     STUB_SOURCES)
 from .description_common import guid
 from .description_fmi2 import model_description
 from .interface import U_START, Interface, preset_interface, vehicle_interface
@@ -53,7 +54,6 @@ def build_native_fmu(itf: Interface, out_dir: Path, model_identifier: str, stub:
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     fmu_guid = guid(itf, model_identifier)
-    src, hdr = source_dir() / "c", fmi_header_dir()
     generated = {"config.h": config_header(itf, model_identifier, fmu_guid),
                  "config_data.h": config_data_header(itf),
                  "vehicle_data.h": vehicle_data_header(itf) if not stub else ""}
@@ -62,14 +62,13 @@ def build_native_fmu(itf: Interface, out_dir: Path, model_identifier: str, stub:
         for name, text in generated.items():
             (tmp / name).write_text(text, encoding="utf-8")
         lib = tmp / f"{model_identifier}.so"
-        sources = [src / s for s in (STUB_SOURCES if stub else NATIVE_SOURCES)]
-        _compile(sources, [tmp, src, hdr], lib, ["-lm"])
+        _compile(c_files(STUB_SOURCES if stub else NATIVE_SOURCES[2]), [tmp, *c_files(INCLUDE_DIRS), fmi_header_dir()],
+                 lib, ["-lm"])
         files = {"modelDescription.xml": model_description(itf, model_identifier, native=True,
                                                            generation_tool="lcvreport.fmu.build (C99)"),
                  f"binaries/linux64/{model_identifier}.so": lib.read_bytes()}
         if not stub:
-            for s in NATIVE_SOURCES + C_HEADERS:
-                files[f"sources/{s}"] = (src / s).read_bytes()
+            files.update(shipped_sources(NATIVE_SOURCES[2] + NATIVE_HEADERS))
             for name, text in generated.items():
                 files[f"sources/{name}"] = text.encode()
             files["sources/README.txt"] = SOURCES_README.format(identifier=model_identifier).encode()
@@ -82,11 +81,10 @@ def build_native_fmu(itf: Interface, out_dir: Path, model_identifier: str, stub:
 def build_native_fmu3(itf: Interface, out_dir: Path, model_identifier: str) -> Path:
     """The FMI 3.0 native FMU ``<model_identifier>.fmu`` (Co-Simulation and Model Exchange),
     from the same model code as the FMI 2.0 one with fmi3_api.c in front (docs/fmu.md)."""
-    from .description_fmi3 import FMI3_SOURCE_FILES, build_description3, model_description3
+    from .description_fmi3 import build_description3, model_description3
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     fmu_guid = guid(itf, model_identifier)
-    src, hdr = source_dir() / "c", fmi_header_dir()
     generated = {"config.h": config_header(itf, model_identifier, fmu_guid),
                  "config_data.h": config_data_header(itf), "vehicle_data.h": vehicle_data_header(itf)}
     with tempfile.TemporaryDirectory() as tmp:
@@ -94,13 +92,13 @@ def build_native_fmu3(itf: Interface, out_dir: Path, model_identifier: str) -> P
         for name, text in generated.items():
             (tmp / name).write_text(text, encoding="utf-8")
         lib = tmp / f"{model_identifier}.so"
-        _compile([src / s for s in FMI3_SOURCE_FILES], [tmp, src, hdr], lib, ["-lm"], defines=["LCV_FMI3"])
+        _compile(c_files(NATIVE_SOURCES[3]), [tmp, *c_files(INCLUDE_DIRS), fmi_header_dir()], lib, ["-lm"],
+                 defines=["LCV_FMI3"])
         files = {"modelDescription.xml": model_description3(itf, model_identifier,
                                                             generation_tool="lcvreport.fmu.build (C99)"),
                  f"binaries/x86_64-linux/{model_identifier}.so": lib.read_bytes(),
                  "sources/buildDescription.xml": build_description3(model_identifier)}
-        for s in FMI3_SOURCE_FILES + C_HEADERS:
-            files[f"sources/{s}"] = (src / s).read_bytes()
+        files.update(shipped_sources(NATIVE_SOURCES[3] + NATIVE_HEADERS))
         for name, text in generated.items():
             files[f"sources/{name}"] = text.encode()
         if not itf.preset_mode:
@@ -172,13 +170,12 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
         (tmp / "loader_config.h").write_text(loader_config_header(itf, model_identifier, fmu_guid, env), "utf-8")
         loader = tmp / f"{model_identifier}.so"
         # Python.h for the types of the initialization API only (the loader links no libpython)
-        _compile([src / "c" / "loader.c", src / "c" / "pyruntime.c", src / "c" / "fmi2_shared.c"],
-                 [tmp, src / "c", fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
+        _compile(c_files(LOADER_SOURCES[2]),
+                 [tmp, *c_files(LOADER_INCLUDE_DIRS), fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
                  ["-ldl", "-lpthread"])
         files[f"binaries/linux64/{model_identifier}.so"] = loader.read_bytes()
         files[f"binaries/linux64/{EXPORT_LIB}"] = export
-        for name in ("loader.c", "pyruntime.c", "pyruntime.h", "fmi2_shared.c", "fmi2_shared.h"):
-            files[f"sources/{name}"] = (src / "c" / name).read_bytes()
+        files.update(shipped_sources(LOADER_SOURCES[2] + LOADER_HEADERS[2]))
         files["sources/loader_config.h"] = (tmp / "loader_config.h").read_bytes()
         files.update(documentation_files(itf, model_identifier, native=False))
         return _zip(out_dir / f"{model_identifier}.fmu", files)
@@ -209,7 +206,6 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     fmu_guid = guid(itf, model_identifier)
-    src = source_dir()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         alias = bundled_package_name(fmu_guid)
@@ -226,14 +222,12 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
         config = config.replace("#endif", f"#define LOADER_TIME_VR {time_value_reference(itf)}\n#endif")
         (tmp / "loader_config.h").write_text(config, "utf-8")
         loader = tmp / f"{model_identifier}.so"
-        _compile([src / "c" / "loader3.c", src / "c" / "pyruntime.c", src / "c" / "fmi2_shared.c"],
-                 [tmp, src / "c", fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
+        _compile(c_files(LOADER_SOURCES[3]),
+                 [tmp, *c_files(LOADER_INCLUDE_DIRS), fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
                  ["-ldl", "-lpthread"], defines=["LCV_FMI3"])
         files[f"binaries/x86_64-linux/{model_identifier}.so"] = loader.read_bytes()
         files[f"binaries/x86_64-linux/{EXPORT_LIB3}"] = export
-        for name in ("loader3.c", "pyruntime.c", "pyruntime.h", "fmi2_shared.c", "fmi2_shared.h",
-                     "fmi3_no_variables.h"):
-            files[f"sources/{name}"] = (src / "c" / name).read_bytes()
+        files.update(shipped_sources(LOADER_SOURCES[3] + LOADER_HEADERS[3]))
         files["sources/loader_config.h"] = (tmp / "loader_config.h").read_bytes()
         doc = documentation_files(itf, model_identifier, native=False)
         doc["documentation/index.html"] = doc["documentation/index.html"].replace(

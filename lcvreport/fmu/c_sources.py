@@ -22,16 +22,6 @@ from .interface import U_MIN_DEFAULT, Interface
 CFLAGS = ["-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Wall", "-Wextra"]
 
 
-#: C sources of the native FMU (fmu_src/c) and of its interface-only twin
-NATIVE_SOURCES = ("fmi2_api.c", "fmi2_shared.c", "model.c", "linalg.c")
-
-
-STUB_SOURCES = ("fmi2_api.c", "fmi2_shared.c", "model_stub.c")
-
-
-C_HEADERS = ("fmi2_shared.h", "model.h", "linalg.h", "vehicle.h", "fmi3_no_variables.h")
-
-
 #: name of pythonfmu's export library inside a pythonfmu FMU (the loader loads it)
 EXPORT_LIB = "pythonfmu-export.so"
 
@@ -44,6 +34,16 @@ class FmuBuildError(RuntimeError):
 def source_dir() -> Path:
     """The FMU sources (``fmu_src/`` in the repository, ``lcvreport/fmu_src`` installed)."""
     return Path(str(resources.files("lcvreport.fmu_src")))
+
+
+def c_files(paths) -> list[Path]:
+    """Paths of the C tree (:mod:`lcvreport.fmu.c_tree`) on this machine."""
+    return [source_dir() / "c" / p for p in paths]
+
+
+def shipped_sources(paths) -> dict:
+    """``{"sources/<name>": bytes}`` of files of the C tree, flat as an FMU holds them."""
+    return {f"sources/{f.name}": f.read_bytes() for f in c_files(paths)}
 
 
 def fmi_header_dir() -> Path:

@@ -16,13 +16,14 @@ from __future__ import annotations
 
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
+from .c_tree import NATIVE_SOURCES, names
 from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial_dependencies, _state_dependencies,
                                  categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
                                  enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
 
 #: the C sources of the native FMU listed in ``<SourceFiles>`` (``fmpy compile`` rebuilds it)
-NATIVE_SOURCE_FILES = ("fmi2_api.c", "fmi2_shared.c", "model.c", "linalg.c")
+NATIVE_SOURCE_FILES = names(NATIVE_SOURCES[2])
 
 
 def model_description(itf: Interface, model_identifier: str, native: bool, generation_tool: str = "lcvreport"

@@ -17,13 +17,14 @@ from __future__ import annotations
 
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
+from .c_tree import NATIVE_SOURCES, names
 from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial_dependencies, _state_dependencies,
                                  categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
                                  enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
 
 #: the C sources of the FMI 3.0 native FMU (built with LCV_FMI3 defined)
-FMI3_SOURCE_FILES = ("fmi3_api.c", "fmi2_shared.c", "model.c", "linalg.c")
+FMI3_SOURCE_FILES = names(NATIVE_SOURCES[3])
 
 
 def time_value_reference(itf: Interface) -> int:

@@ -1,5 +1,5 @@
 """The driver FMU: a path-following driver (FMI 2.0, Co-Simulation and Model Exchange, C99),
-built from ``fmu_src/c/driver.c`` with the start values of
+built from ``fmu_src/c/driver/driver.c`` with the start values of
 :data:`lcvreport.manoeuvres.drivers.DEFAULT` (docs/fmu.md, the SSP example).
 
 Examples
@@ -18,12 +18,13 @@ from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from ..manoeuvres.drivers import DEFAULT
-from .c_sources import _compile, fmi_header_dir, source_dir
+from .c_sources import _compile, c_files, fmi_header_dir, shipped_sources
+from .c_tree import DRIVER_HEADERS, DRIVER_INCLUDE_DIRS, DRIVER_SOURCES, names
 from .description_common import _num
 from .package import _zip, documentation_files
 
 MODEL_IDENTIFIER = "PreviewDriver"
-SOURCES = ("driver.c", "fmi2_shared.c")
+SOURCES = names(DRIVER_SOURCES)
 #: name, causality, unit, start, (min, max), description; value references in this order
 VARIABLES = (
     ("gain_rad_per_m", "parameter", "rad/m", DEFAULT.gain_rad_per_m, (0.0, 1.0),
@@ -42,7 +43,7 @@ UNITS = {"rad/m": {"rad": "1", "m": "-1"}, "m": {"m": "1"}, "s": {"s": "1"}, "ra
 
 
 def driver_guid() -> str:
-    h = hashlib.sha256(repr((MODEL_IDENTIFIER, VARIABLES, (source_dir() / "c" / "driver.c").read_bytes())).encode())
+    h = hashlib.sha256(repr((MODEL_IDENTIFIER, VARIABLES, c_files(DRIVER_SOURCES)[0].read_bytes())).encode())
     return "{" + str(uuid.UUID(bytes=h.digest()[:16], version=5)) + "}"
 
 
@@ -99,17 +100,15 @@ def build_driver_fmu(out_dir: str | Path) -> Path:
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     fmu_guid = driver_guid()
-    src = source_dir() / "c"
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         (tmp / "driver_config.h").write_text(driver_config_header(fmu_guid), encoding="utf-8")
         lib = tmp / f"{MODEL_IDENTIFIER}.so"
-        _compile([src / s for s in SOURCES], [tmp, src, fmi_header_dir()], lib, ["-lm"])
+        _compile(c_files(DRIVER_SOURCES), [tmp, *c_files(DRIVER_INCLUDE_DIRS), fmi_header_dir()], lib, ["-lm"])
         files = {"modelDescription.xml": driver_model_description(fmu_guid),
                  f"binaries/linux64/{MODEL_IDENTIFIER}.so": lib.read_bytes(),
                  "sources/driver_config.h": (tmp / "driver_config.h").read_bytes()}
-        for s in SOURCES + ("fmi2_shared.h",):
-            files[f"sources/{s}"] = (src / s).read_bytes()
+        files.update(shipped_sources(DRIVER_SOURCES + DRIVER_HEADERS))
 
         class _Itf:
             description = "Path-following driver with preview (lcvreport.manoeuvres.drivers.PreviewDriver)."

@@ -10,7 +10,7 @@ FMI functions are spelled.  ``resources/lcv_fmu.json`` says which interface: the
 No exception may leave a callback: pythonfmu turns one into a Fatal status after releasing the
 Python instance, which freeInstance then releases again (a use-after-free that crashes the
 host).  Every callback catches, logs an error and returns something harmless; the FMU's loader
-(``fmu_src/c/loader.c``, ``loader3.c``) turns a call that logged an error into the Error status
+(``fmu_src/c/python/loader.c``, ``loader3.c``) turns a call that logged an error into the Error status
 the standard asks for.
 """
 import json

@@ -5,7 +5,7 @@ What it computes is the core's, the same as the FMI 2.0 Python FMU; this adapter
 calls pythonfmu3 makes (``get_float64``, ``set_int64`` ...) onto the core's, logs through
 pythonfmu3's log queue and writes the FMI 3.0 modelDescription.xml
 (:func:`lcvreport.fmu.description_fmi3.model_description3`, Co-Simulation only).  The loader in
-front of pythonfmu3 (``fmu_src/c/loader3.c``) checks every argument, keeps the state machine and
+front of pythonfmu3 (``fmu_src/c/python/loader3.c``) checks every argument, keeps the state machine and
 turns a call that logged an error into ``fmi3Error``.
 """
 from pythonfmu3 import Fmi3Slave

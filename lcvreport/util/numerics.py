@@ -11,7 +11,7 @@ embedded interpreter imports numpy and nothing heavier.
   Higham, SIAM J. Matrix Anal. Appl. 31 (2009), Algorithm 5.1 -- the algorithm of
   ``scipy.linalg.expm`` (which the analysis layer uses), with the 1-norms of
   ``|A|^(2m+1)`` computed exactly instead of estimated.  The C FMU implements the same
-  algorithm (``fmu_src/c/linalg.c``); the tests hold both against scipy and a 40-digit
+  algorithm (``fmu_src/c/vehicle/linalg.c``); the tests hold both against scipy and a 40-digit
   reference.
 
 Examples
