@@ -46,7 +46,7 @@ def test_sources_are_listed_and_the_official_headers_not_shipped(every_fmu):
         if native:
             for kind in ("ModelExchange", "CoSimulation"):
                 files = [f.get("name") for f in root.find(kind).iter("File")]
-                assert files == ["fmi2_api.c", "fmi2_shared.c", "model.c", "linalg.c"], (name, kind)
+                assert files == ["fmi2_api.c", "fmu_common.c", "model.c", "linalg.c"], (name, kind)
             assert all(f"sources/{f}" in names for f in files), name
 
 

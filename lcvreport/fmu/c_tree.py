@@ -7,7 +7,7 @@ buildDescription.xml (FMI 3) lists their names (:func:`names`), so ``fmpy compil
 Examples
 --------
 >>> names(NATIVE_SOURCES[2])
-('fmi2_api.c', 'fmi2_shared.c', 'model.c', 'linalg.c')
+('fmi2_api.c', 'fmu_common.c', 'model.c', 'linalg.c')
 """
 from __future__ import annotations
 
@@ -16,23 +16,23 @@ from pathlib import PurePosixPath
 #: the folders the native FMUs' sources include from
 INCLUDE_DIRS = ("api", "vehicle")
 #: the native FMU's sources per FMI version (the API file first)
-NATIVE_SOURCES = {2: ("api/fmi2_api.c", "api/fmi2_shared.c", "vehicle/model.c", "vehicle/linalg.c"),
-                  3: ("api/fmi3_api.c", "api/fmi2_shared.c", "vehicle/model.c", "vehicle/linalg.c")}
+NATIVE_SOURCES = {2: ("api/fmi2_api.c", "api/fmu_common.c", "vehicle/model.c", "vehicle/linalg.c"),
+                  3: ("api/fmi3_api.c", "api/fmu_common.c", "vehicle/model.c", "vehicle/linalg.c")}
 #: the interface-only twin of the FMI 2 native FMU (no model: benchmarks)
-STUB_SOURCES = ("api/fmi2_api.c", "api/fmi2_shared.c", "vehicle/model_stub.c")
+STUB_SOURCES = ("api/fmi2_api.c", "api/fmu_common.c", "vehicle/model_stub.c")
 #: the headers shipped in a native FMU's sources/
-NATIVE_HEADERS = ("api/fmi2_shared.h", "vehicle/model.h", "vehicle/linalg.h", "vehicle/vehicle.h",
+NATIVE_HEADERS = ("api/fmu_common.h", "vehicle/model.h", "vehicle/linalg.h", "vehicle/vehicle.h",
                   "api/fmi3_no_variables.h")
 #: the Python FMUs' loaders per FMI version: sources, and the headers shipped beside them
 LOADER_INCLUDE_DIRS = ("api", "python")
-LOADER_SOURCES = {2: ("python/loader.c", "python/pyruntime.c", "api/fmi2_shared.c"),
-                  3: ("python/loader3.c", "python/pyruntime.c", "api/fmi2_shared.c")}
-LOADER_HEADERS = {2: ("python/pyruntime.h", "api/fmi2_shared.h"),
-                  3: ("python/pyruntime.h", "api/fmi2_shared.h", "api/fmi3_no_variables.h")}
+LOADER_SOURCES = {2: ("python/loader.c", "python/pyruntime.c", "api/fmu_common.c"),
+                  3: ("python/loader3.c", "python/pyruntime.c", "api/fmu_common.c")}
+LOADER_HEADERS = {2: ("python/pyruntime.h", "api/fmu_common.h"),
+                  3: ("python/pyruntime.h", "api/fmu_common.h", "api/fmi3_no_variables.h")}
 #: the driver FMU (FMI 2)
 DRIVER_INCLUDE_DIRS = ("api",)
-DRIVER_SOURCES = ("driver/driver.c", "api/fmi2_shared.c")
-DRIVER_HEADERS = ("api/fmi2_shared.h",)
+DRIVER_SOURCES = ("driver/driver.c", "api/fmu_common.c")
+DRIVER_HEADERS = ("api/fmu_common.h",)
 
 
 def names(paths) -> tuple[str, ...]:

@@ -14,7 +14,7 @@ from .interface import Interface
 SOURCES_README = """{identifier}: FMI 2.0 co-simulation FMU of the linear LCV yaw-plane model (C99, libc + libm).
 
 fmi2_api.c      the FMI 2.0 API and its state machine
-fmi2_shared.c   log formatting, unsupported status queries (shared with the pythonfmu loader)
+fmu_common.c    log formatting, phase names, unsupported status queries (shared by every FMU here)
 model.c         the model: parameters, checks, exact zero-order-hold steps, outputs
 linalg.c        solve, matrix exponential (Al-Mohy & Higham 2009), eigenvalues
 config.h        the interface table: ValueReference enum, sizes, ranges (generated)
@@ -25,9 +25,9 @@ The official FMI 2.0 headers (fmi2Functions.h, fmi2FunctionTypes.h, fmi2TypesPla
 not shipped (FMI 2.0.4, section 2.1: sources/ holds the model's own files); any importer that
 compiles FMUs has them, e.g. fmpy's c-code folder. modelDescription.xml lists the four .c
 files, so `fmpy compile {identifier}.fmu` rebuilds the binary. By hand, with FMI=<the headers>:
-    cc -std=c99 -O2 -fPIC -shared -I$FMI -o {identifier}.so fmi2_api.c fmi2_shared.c model.c linalg.c -lm   (Linux)
-    cc -std=c99 -O2 -dynamiclib -I$FMI -o {identifier}.dylib fmi2_api.c fmi2_shared.c model.c linalg.c -lm (macOS)
-    cl /O2 /LD /I%FMI% /Fe:{identifier}.dll fmi2_api.c fmi2_shared.c model.c linalg.c                       (Windows)
+    cc -std=c99 -O2 -fPIC -shared -I$FMI -o {identifier}.so fmi2_api.c fmu_common.c model.c linalg.c -lm   (Linux)
+    cc -std=c99 -O2 -dynamiclib -I$FMI -o {identifier}.dylib fmi2_api.c fmu_common.c model.c linalg.c -lm (macOS)
+    cl /O2 /LD /I%FMI% /Fe:{identifier}.dll fmi2_api.c fmu_common.c model.c linalg.c                       (Windows)
 """
 
 

@@ -16,8 +16,14 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
-#include "fmi2_shared.h"
+#include "fmu_common.h"
 #include "model.h"
+
+/* an FMI 2 instance: the model's, and what is FMI's (the host's callbacks) */
+typedef struct {
+    ModelInstance m;                      /* first: an Instance2* is a ModelInstance* */
+    fmi2CallbackFunctions cb;
+} Instance2;
 
 /* phases a call is allowed in (Model Exchange: EventMode and ContinuousTimeMode after
    initialization instead of StepComplete) */
@@ -45,31 +51,31 @@
 #define MASK_fmi2SetInteger (PhaseInstantiated | PhaseInitializationMode)
 #define MASK_fmi2GetInteger ANY_PHASE
 
-static void logmsg(ModelInstance *c, fmi2Status status, const char *fmt, ...)
+static void logmsg(Instance2 *c, fmi2Status status, const char *fmt, ...)
 {
     char esc[2400];
     va_list ap;
     if (!c || !c->cb.logger) return;
-    if (!c->logging_on && status < fmi2Warning) return;
+    if (!c->m.logging_on && status < fmi2Warning) return;
     va_start(ap, fmt);
     format_log_message(esc, sizeof esc, fmt, ap);
     va_end(ap);
-    c->cb.logger(c->cb.componentEnvironment, c->name, status, log_category(status), esc);
+    c->cb.logger(c->cb.componentEnvironment, c->m.name, status, log_category(status), esc);
 }
 
 /* check the instance and the phase; on failure log and return fmi2Error */
-static int allowed(ModelInstance *c, const char *function, int mask)
+static int allowed(Instance2 *c, const char *function, int mask)
 {
     if (!c) return 0;
-    if (!(c->s.phase & mask)) {
-        logmsg(c, fmi2Error, "%s must not be called in phase %s", function, phase_name(c->s.phase));
+    if (!(c->m.s.phase & mask)) {
+        logmsg(c, fmi2Error, "%s must not be called in phase %s", function, phase_name(c->m.s.phase));
         return 0;
     }
     return 1;
 }
 
 #define BEGIN_FUNCTION(F) \
-    ModelInstance *c = (ModelInstance *)comp; \
+    Instance2 *c = (Instance2 *)comp; \
     if (!allowed(c, "fmi2" #F, MASK_fmi2##F)) return fmi2Error;
 
 /* ------------------------------------------------------------------ inquiry and set-up */
@@ -80,13 +86,13 @@ fmi2Status fmi2SetDebugLogging(fmi2Component comp, fmi2Boolean loggingOn, size_t
                                const fmi2String categories[])
 {
     (void)categories;
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
     if (nCategories > 0 && !categories) {
         logmsg(c, fmi2Error, "fmi2SetDebugLogging: %u categories but no array", (unsigned)nCategories);
         return fmi2Error;
     }
-    c->logging_on = loggingOn;
+    c->m.logging_on = loggingOn;
     return fmi2OK;
 }
 
@@ -107,26 +113,26 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                           "guid mismatch: the modelDescription.xml does not belong to this binary");
         return NULL;
     }
-    ModelInstance *c = (ModelInstance *)calloc(1, sizeof(ModelInstance));
+    Instance2 *c = (Instance2 *)calloc(1, sizeof(Instance2));
     if (!c) {
         functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError", "out of memory");
         return NULL;
     }
     memcpy((void *)&c->cb, functions, sizeof(fmi2CallbackFunctions));
-    c->name = (char *)malloc(strlen(name) + 1);
-    if (!c->name) { free(c); return NULL; }
-    strcpy(c->name, name);
-    c->logging_on = loggingOn;
-    c->model_exchange = fmuType == fmi2ModelExchange;
-    model_reset(c);
+    c->m.name = (char *)malloc(strlen(name) + 1);
+    if (!c->m.name) { free(c); return NULL; }
+    strcpy(c->m.name, name);
+    c->m.logging_on = loggingOn;
+    c->m.model_exchange = fmuType == fmi2ModelExchange;
+    model_reset(&c->m);
     return c;
 }
 
 void fmi2FreeInstance(fmi2Component comp)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return;
-    free(c->name);
+    free(c->m.name);
     free(c);
 }
 
@@ -139,44 +145,44 @@ fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean toleranceDefined,
         logmsg(c, fmi2Error, "fmi2SetupExperiment: startTime is not finite (%g)", startTime);
         return fmi2Error;
     }
-    c->s.time = startTime;
+    c->m.s.time = startTime;
     return fmi2OK;
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component comp)
 {
     BEGIN_FUNCTION(EnterInitializationMode)
-    c->s.phase = PhaseInitializationMode;
+    c->m.s.phase = PhaseInitializationMode;
     return fmi2OK;
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component comp)
 {
     BEGIN_FUNCTION(ExitInitializationMode)
-    double t0 = c->s.time;
-    if (model_exit_initialization(c) != 0) {
-        snprintf(c->s.error, sizeof c->s.error, "%s", c->msg);
-        c->s.phase = PhaseError;
-        logmsg(c, fmi2Error, "%s; every doStep will be refused (fmi2Reset to start again)", c->s.error);
+    double t0 = c->m.s.time;
+    if (model_exit_initialization(&c->m) != 0) {
+        snprintf(c->m.s.error, sizeof c->m.s.error, "%s", c->m.msg);
+        c->m.s.phase = PhaseError;
+        logmsg(c, fmi2Error, "%s; every doStep will be refused (fmi2Reset to start again)", c->m.s.error);
         return fmi2Error;
     }
-    c->s.time = t0;
-    c->s.phase = c->model_exchange ? PhaseEventMode : PhaseStepComplete;
+    c->m.s.time = t0;
+    c->m.s.phase = c->m.model_exchange ? PhaseEventMode : PhaseStepComplete;
     return fmi2OK;
 }
 
 fmi2Status fmi2Terminate(fmi2Component comp)
 {
     BEGIN_FUNCTION(Terminate)
-    c->s.phase = PhaseTerminated;
+    c->m.s.phase = PhaseTerminated;
     return fmi2OK;
 }
 
 fmi2Status fmi2Reset(fmi2Component comp)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
-    model_reset(c);
+    model_reset(&c->m);
     return fmi2OK;
 }
 
@@ -186,8 +192,8 @@ fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
     BEGIN_FUNCTION(GetReal)
     if (nvr == 0) return fmi2OK;
     if (!vr || !value) { logmsg(c, fmi2Error, "fmi2GetReal: null array"); return fmi2Error; }
-    if (model_get_real(c, vr, nvr, value) != 0) {
-        logmsg(c, fmi2Error, "%s", c->msg);
+    if (model_get_real(&c->m, vr, nvr, value) != 0) {
+        logmsg(c, fmi2Error, "fmi2GetReal: %s", c->m.msg);
         return fmi2Error;
     }
     return fmi2OK;
@@ -200,8 +206,8 @@ fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
     if (!vr || !value) { logmsg(c, fmi2Error, "fmi2SetReal: null array"); return fmi2Error; }
     fmi2Status status = fmi2OK;
     for (size_t i = 0; i < nvr; ++i) {
-        if (model_set_real(c, vr[i], value[i]) != 0) {
-            logmsg(c, fmi2Error, "%s", c->msg);
+        if (model_set_real(&c->m, vr[i], value[i]) != 0) {
+            logmsg(c, fmi2Error, "fmi2SetReal: %s", c->m.msg);
             status = fmi2Error;
         }
     }
@@ -215,8 +221,8 @@ fmi2Status fmi2GetString(fmi2Component comp, const fmi2ValueReference vr[], size
     if (!vr || !value) { logmsg(c, fmi2Error, "fmi2GetString: null array"); return fmi2Error; }
     fmi2Status status = fmi2OK;
     for (size_t i = 0; i < nvr; ++i) {
-        if (model_get_string(c, vr[i], &value[i]) != 0) {
-            logmsg(c, fmi2Error, "%s", c->msg);
+        if (model_get_string(&c->m, vr[i], &value[i]) != 0) {
+            logmsg(c, fmi2Error, "fmi2GetString: %s", c->m.msg);
             status = fmi2Error;
         }
     }
@@ -230,8 +236,8 @@ fmi2Status fmi2SetString(fmi2Component comp, const fmi2ValueReference vr[], size
     if (!vr || !value) { logmsg(c, fmi2Error, "fmi2SetString: null array"); return fmi2Error; }
     fmi2Status status = fmi2OK;
     for (size_t i = 0; i < nvr; ++i) {
-        if (model_set_string(c, vr[i], value[i]) != 0) {
-            logmsg(c, fmi2Error, "%s", c->msg);
+        if (model_set_string(&c->m, vr[i], value[i]) != 0) {
+            logmsg(c, fmi2Error, "fmi2SetString: %s", c->m.msg);
             status = fmi2Error;
         }
     }
@@ -240,7 +246,7 @@ fmi2Status fmi2SetString(fmi2Component comp, const fmi2ValueReference vr[], size
 
 static fmi2Status no_variables(fmi2Component comp, size_t nvr, const char *function, const char *type)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     logmsg(c, fmi2Error, "%s: this FMU has no %s variables", function, type);
@@ -256,8 +262,8 @@ fmi2Status fmi2GetInteger(fmi2Component comp, const fmi2ValueReference vr[], siz
     fmi2Status status = fmi2OK;
     for (size_t i = 0; i < nvr; ++i) {
         int v = 0;
-        if (model_get_integer(c, vr[i], &v) != 0) {
-            logmsg(c, fmi2Error, "fmi2GetInteger: %s", c->msg);
+        if (model_get_integer(&c->m, vr[i], &v) != 0) {
+            logmsg(c, fmi2Error, "fmi2GetInteger: %s", c->m.msg);
             status = fmi2Error;
         }
         value[i] = v;
@@ -272,8 +278,8 @@ fmi2Status fmi2SetInteger(fmi2Component comp, const fmi2ValueReference vr[], siz
     if (!vr || !value) { logmsg(c, fmi2Error, "fmi2SetInteger: null array"); return fmi2Error; }
     fmi2Status status = fmi2OK;
     for (size_t i = 0; i < nvr; ++i) {
-        if (model_set_integer(c, vr[i], value[i]) != 0) {
-            logmsg(c, fmi2Error, "fmi2SetInteger: %s", c->msg);
+        if (model_set_integer(&c->m, vr[i], value[i]) != 0) {
+            logmsg(c, fmi2Error, "fmi2SetInteger: %s", c->m.msg);
             status = fmi2Error;
         }
     }
@@ -297,25 +303,25 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real currentCommunicationPoint, fm
                       fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint)
 {
     (void)currentCommunicationPoint; (void)noSetFMUStatePriorToCurrentCommunicationPoint;
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
-    if (c->s.phase == PhaseError) {
-        logmsg(c, fmi2Error, "%s; every doStep will be refused (fmi2Reset to start again)", c->s.error);
+    if (c->m.s.phase == PhaseError) {
+        logmsg(c, fmi2Error, "%s; every doStep will be refused (fmi2Reset to start again)", c->m.s.error);
         return fmi2Error;
     }
     if (!allowed(c, "fmi2DoStep", MASK_fmi2DoStep)) return fmi2Error;
-    int r = model_do_step(c, communicationStepSize);
+    int r = model_do_step(&c->m, communicationStepSize);
     if (r < 0) {
-        logmsg(c, fmi2Error, "%s", c->msg);
+        logmsg(c, fmi2Error, "%s", c->m.msg);
         return fmi2Error;
     }
-    if (r > 0) logmsg(c, fmi2Warning, "%s", c->msg);
+    if (r > 0) logmsg(c, fmi2Warning, "%s", c->m.msg);
     return r > 0 ? fmi2Warning : fmi2OK;    /* a clamped speed: the Python FMU's status too */
 }
 
 fmi2Status fmi2CancelStep(fmi2Component comp)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (c) logmsg(c, fmi2Error, "fmi2CancelStep: steps are not asynchronous");
     return fmi2Error;
 }
@@ -325,11 +331,11 @@ fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time)
 {
     BEGIN_FUNCTION(SetTime)
     if (!isfinite(time)) { logmsg(c, fmi2Error, "fmi2SetTime: time is not finite (%g)", time); return fmi2Error; }
-    c->s.time = time;
+    c->m.s.time = time;
     return fmi2OK;
 }
 
-static int states_arg(ModelInstance *c, const char *function, const void *x, size_t nx)
+static int states_arg(Instance2 *c, const char *function, const void *x, size_t nx)
 {
     if (nx != LCV_N_ME_STATES) {
         logmsg(c, fmi2Error, "%s: %u states given, this FMU has %u", function, (unsigned)nx, (unsigned)LCV_N_ME_STATES);
@@ -349,7 +355,7 @@ fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_
                    LCV_VARIABLE_NAME(LCV_ME_STATE_VR_OF(i)), x[i]);
             return fmi2Error;
         }
-    model_set_states(c, x, nx);
+    model_set_states(&c->m, x, nx);
     return fmi2OK;
 }
 
@@ -357,7 +363,7 @@ fmi2Status fmi2GetContinuousStates(fmi2Component comp, fmi2Real x[], size_t nx)
 {
     BEGIN_FUNCTION(GetContinuousStates)
     if (!states_arg(c, "fmi2GetContinuousStates", x, nx)) return fmi2Error;
-    model_get_states(c, x, nx);
+    model_get_states(&c->m, x, nx);
     return fmi2OK;
 }
 
@@ -365,9 +371,9 @@ fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx)
 {
     BEGIN_FUNCTION(GetDerivatives)
     if (!states_arg(c, "fmi2GetDerivatives", dx, nx)) return fmi2Error;
-    int r = model_derivatives(c, dx, nx);
-    if (r < 0) { logmsg(c, fmi2Error, "%s", c->msg); return fmi2Error; }
-    if (r > 0) logmsg(c, fmi2Warning, "%s", c->msg);
+    int r = model_derivatives(&c->m, dx, nx);
+    if (r < 0) { logmsg(c, fmi2Error, "%s", c->m.msg); return fmi2Error; }
+    if (r > 0) logmsg(c, fmi2Warning, "%s", c->m.msg);
     return r > 0 ? fmi2Warning : fmi2OK;
 }
 
@@ -375,7 +381,7 @@ fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real x_nomi
 {
     BEGIN_FUNCTION(GetNominalsOfContinuousStates)
     if (!states_arg(c, "fmi2GetNominalsOfContinuousStates", x_nominal, nx)) return fmi2Error;
-    model_get_nominals(c, x_nominal, nx);     /* each state's physical scale */
+    model_get_nominals(&c->m, x_nominal, nx);     /* each state's physical scale */
     return fmi2OK;
 }
 
@@ -390,7 +396,7 @@ fmi2Status fmi2GetEventIndicators(fmi2Component comp, fmi2Real eventIndicators[]
 fmi2Status fmi2EnterEventMode(fmi2Component comp)
 {
     BEGIN_FUNCTION(EnterEventMode)
-    c->s.phase = PhaseEventMode;
+    c->m.s.phase = PhaseEventMode;
     return fmi2OK;
 }
 
@@ -410,7 +416,7 @@ fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *eventInfo)
 fmi2Status fmi2EnterContinuousTimeMode(fmi2Component comp)
 {
     BEGIN_FUNCTION(EnterContinuousTimeMode)
-    c->s.phase = PhaseContinuousTimeMode;
+    c->m.s.phase = PhaseContinuousTimeMode;
     return fmi2OK;
 }
 
@@ -437,15 +443,15 @@ typedef struct {
     ModelState s;
 } Snapshot;
 
-static int snapshot_ok(ModelInstance *c, const Snapshot *snap)
+static int snapshot_ok(Instance2 *c, const Snapshot *snap)
 {
     if (snap->magic != STATE_MAGIC || snap->size != sizeof(Snapshot) ||
         memchr(snap->guid, '\0', sizeof snap->guid) == NULL || strcmp(snap->guid, LCV_GUID) != 0) {
         logmsg(c, fmi2Error, "the FMU state was not written by this FMU (another model or version)");
         return 0;
     }
-    if (model_check_state(c, &snap->s) != 0) {
-        logmsg(c, fmi2Error, "%s", c->msg);
+    if (model_check_state(&c->m, &snap->s) != 0) {
+        logmsg(c, fmi2Error, "%s", c->m.msg);
         return 0;
     }
     return 1;
@@ -453,7 +459,7 @@ static int snapshot_ok(ModelInstance *c, const Snapshot *snap)
 
 fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
     if (!state) { logmsg(c, fmi2Error, "fmi2GetFMUstate: null pointer"); return fmi2Error; }
     Snapshot *snap = (Snapshot *)(*state);
@@ -465,29 +471,28 @@ fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
     snap->size = (unsigned)sizeof(Snapshot);
     memset(snap->guid, 0, sizeof snap->guid);
     snprintf(snap->guid, sizeof snap->guid, "%s", LCV_GUID);
-    snap->s = c->s;
+    snap->s = c->m.s;
     *state = snap;
     return fmi2OK;
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate state)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
     const Snapshot *snap = (const Snapshot *)state;
     if (!snap) { logmsg(c, fmi2Error, "fmi2SetFMUstate: null state"); return fmi2Error; }
     if (!snapshot_ok(c, snap)) return fmi2Error;
-    int same = c->s.vehicle == snap->s.vehicle && c->s.tire_scale == snap->s.tire_scale &&
-               c->s.crossfall == snap->s.crossfall;
-    c->s = snap->s;
-    model_state_restored(c, same);
+    ModelState before = c->m.s;
+    c->m.s = snap->s;
+    model_state_restored(&c->m, &before);
     return fmi2OK;
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state)
 {
     if (!comp) return fmi2Error;
-    if (!state) { logmsg((ModelInstance *)comp, fmi2Error, "fmi2FreeFMUstate: null pointer"); return fmi2Error; }
+    if (!state) { logmsg((Instance2 *)comp, fmi2Error, "fmi2FreeFMUstate: null pointer"); return fmi2Error; }
     free(*state);
     *state = NULL;
     return fmi2OK;
@@ -495,7 +500,7 @@ fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state)
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, size_t *size)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
     if (!state || !size) { logmsg(c, fmi2Error, "fmi2SerializedFMUstateSize: null pointer"); return fmi2Error; }
     *size = sizeof(Snapshot);
@@ -504,7 +509,7 @@ fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, si
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byte serializedState[], size_t size)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
     if (!state || !serializedState) { logmsg(c, fmi2Error, "fmi2SerializeFMUstate: null pointer"); return fmi2Error; }
     if (size < sizeof(Snapshot)) {
@@ -519,7 +524,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byt
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *state)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c) return fmi2Error;
     if (!serializedState || !state) { logmsg(c, fmi2Error, "fmi2DeSerializeFMUstate: null pointer"); return fmi2Error; }
     if (size != sizeof(Snapshot)) {
@@ -551,8 +556,8 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueRefer
         logmsg(c, fmi2Error, "fmi2GetDirectionalDerivative: null array");
         return fmi2Error;
     }
-    if (model_directional(c, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown) != 0) {
-        logmsg(c, fmi2Error, "%s", c->msg);
+    if (model_directional(&c->m, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown) != 0) {
+        logmsg(c, fmi2Error, "%s", c->m.msg);
         return fmi2Error;
     }
     return fmi2OK;
@@ -562,7 +567,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2ValueRefere
                                        const fmi2Integer order[], const fmi2Real value[])
 {
     (void)vr; (void)nvr; (void)order; (void)value;
-    if (comp) logmsg((ModelInstance *)comp, fmi2Error, "input derivatives are not supported");
+    if (comp) logmsg((Instance2 *)comp, fmi2Error, "input derivatives are not supported");
     return fmi2Error;
 }
 
@@ -570,7 +575,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fmi2ValueRefer
                                         const fmi2Integer order[], fmi2Real value[])
 {
     (void)vr; (void)nvr; (void)order; (void)value;
-    if (comp) logmsg((ModelInstance *)comp, fmi2Error, "output derivatives are not provided");
+    if (comp) logmsg((Instance2 *)comp, fmi2Error, "output derivatives are not provided");
     return fmi2Error;
 }
 
@@ -584,9 +589,9 @@ fmi2Status fmi2GetStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Status 
 
 fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Real *value)
 {
-    ModelInstance *c = (ModelInstance *)comp;
+    Instance2 *c = (Instance2 *)comp;
     if (!c || !value) return fmi2Error;
-    if (s == fmi2LastSuccessfulTime) { *value = c->s.time; return fmi2OK; }
+    if (s == fmi2LastSuccessfulTime) { *value = c->m.s.time; return fmi2OK; }
     return fmi2Discard;
 }
 

@@ -37,7 +37,7 @@ static void logmsg(Instance3 *c, fmi3Status status, const char *fmt, ...)
     va_start(ap, fmt);
     format_log_message(esc, sizeof esc, fmt, ap);
     va_end(ap);
-    c->log(c->env, status, log_category((fmi2Status)status), esc);
+    c->log(c->env, status, log_category(status), esc);
 }
 
 static int allowed(Instance3 *c, const char *function, int mask)
@@ -213,9 +213,9 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
     for (size_t i = 0; i < nValueReferences; ++i) {
         fmi3ValueReference r = valueReferences[i];
         if (r == LCV_TIME_VR) { values[i] = c->m.s.time; continue; }
-        fmi2ValueReference r2 = r;
+        unsigned r2 = r;
         if (model_get_real(&c->m, &r2, 1, &values[i]) != 0) {
-            logmsg(c, fmi3Error, "%s", c->m.msg);
+            logmsg(c, fmi3Error, "fmi3GetFloat64: %s", c->m.msg);
             status = fmi3Error;
         }
     }
@@ -230,7 +230,7 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
     fmi3Status status = fmi3OK;
     for (size_t i = 0; i < nValueReferences; ++i)
         if (model_set_real(&c->m, valueReferences[i], values[i]) != 0) {
-            logmsg(c, fmi3Error, "%s", c->m.msg);
+            logmsg(c, fmi3Error, "fmi3SetFloat64: %s", c->m.msg);
             status = fmi3Error;
         }
     return status;
@@ -244,7 +244,7 @@ fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference valueRe
     fmi3Status status = fmi3OK;
     for (size_t i = 0; i < nValueReferences; ++i)
         if (model_get_string(&c->m, valueReferences[i], &values[i]) != 0) {
-            logmsg(c, fmi3Error, "%s", c->m.msg);
+            logmsg(c, fmi3Error, "fmi3GetString: %s", c->m.msg);
             status = fmi3Error;
         }
     return status;
@@ -258,7 +258,7 @@ fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference valueRe
     fmi3Status status = fmi3OK;
     for (size_t i = 0; i < nValueReferences; ++i)
         if (model_set_string(&c->m, valueReferences[i], values[i]) != 0) {
-            logmsg(c, fmi3Error, "%s", c->m.msg);
+            logmsg(c, fmi3Error, "fmi3SetString: %s", c->m.msg);
             status = fmi3Error;
         }
     return status;
@@ -408,10 +408,9 @@ fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
     const Snapshot *snap = (const Snapshot *)FMUState;
     if (!snap) { logmsg(c, fmi3Error, "fmi3SetFMUState: null state"); return fmi3Error; }
     if (!snapshot_ok(c, snap)) return fmi3Error;
-    int same = c->m.s.vehicle == snap->s.vehicle && c->m.s.tire_scale == snap->s.tire_scale &&
-               c->m.s.crossfall == snap->s.crossfall;
+    ModelState before = c->m.s;
     c->m.s = snap->s;
-    model_state_restored(&c->m, same);
+    model_state_restored(&c->m, &before);
     return fmi3OK;
 }
 

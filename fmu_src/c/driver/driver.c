@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
-#include "fmi2_shared.h"
+#include "fmu_common.h"
 #include "driver_config.h"
 
 enum { VR_K, VR_L, VR_TARGET, VR_T0, VR_T, VR_Y1, VR_PSI1, VR_DELTA, N_VR };

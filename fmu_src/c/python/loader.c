@@ -48,7 +48,7 @@
 #include <wchar.h>
 
 #include "fmi2Functions.h"
-#include "fmi2_shared.h"
+#include "fmu_common.h"
 #include "loader_config.h"
 #include "pyruntime.h"
 
@@ -81,7 +81,7 @@ static void resolve(void)
 #undef RESOLVE
 }
 
-/* phases: the C FMU's (fmi2_shared.h), with the same masks as fmi2_api.c */
+/* phases: the C FMU's (fmu_common.h), with the same masks as fmi2_api.c */
 #define MASK_fmi2SetupExperiment PhaseInstantiated
 #define MASK_fmi2EnterInitializationMode PhaseInstantiated
 #define MASK_fmi2ExitInitializationMode PhaseInitializationMode

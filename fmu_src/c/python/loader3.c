@@ -27,7 +27,7 @@
 #include <string.h>
 
 #include "fmi3Functions.h"
-#include "fmi2_shared.h"
+#include "fmu_common.h"
 #include "loader_config.h"
 #include "pyruntime.h"
 
@@ -59,7 +59,7 @@ static void resolve(void)
 #undef RESOLVE
 }
 
-/* phases (fmi2_shared.h): Co-Simulation without event mode */
+/* phases (fmu_common.h): Co-Simulation without event mode */
 #define PhaseStepMode PhaseStepComplete
 #define BEFORE_INIT (PhaseInstantiated | PhaseInitializationMode)
 
@@ -96,7 +96,7 @@ static void say(Wrapper *w, fmi3Status status, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
-    w->host_log(w->host_env, status, log_category((fmi2Status)status), text);
+    w->host_log(w->host_env, status, log_category(status), text);
 }
 
 static void own_logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message)
@@ -105,7 +105,7 @@ static void own_logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3Strin
     if (!w) return;
     if ((int)status > w->worst) w->worst = (int)status;
     if (!w->host_log || (!w->logging_on && status < fmi3Warning)) return;
-    w->host_log(w->host_env, status, category && *category ? category : log_category((fmi2Status)status),
+    w->host_log(w->host_env, status, category && *category ? category : log_category(status),
                 message ? message : "");
 }
 

@@ -616,7 +616,7 @@ static void compute_outputs(ModelInstance *c, const char *want, double *out, int
     if (why[0]) snprintf(c->msg, sizeof c->msg, "%s", why);
 }
 
-int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, double value[])
+int model_get_real(ModelInstance *c, const unsigned vr[], size_t nvr, double value[])
 {
     double out[LCV_N_OUTPUTS];
     int valid[LCV_N_OUTPUTS];
@@ -653,14 +653,14 @@ int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, 
             if (!valid[r - LCV_FIRST_OUTPUT]) status = -1;
         } else {
             value[i] = 0.0;
-            snprintf(c->msg, sizeof c->msg, "fmi2GetReal: %u is not the value reference of a Real variable", r);
+            snprintf(c->msg, sizeof c->msg, "%u is not the value reference of a Real variable", r);
             status = -1;
         }
     }
     return status;
 }
 
-int model_set_real(ModelInstance *c, fmi2ValueReference vr, double value)
+int model_set_real(ModelInstance *c, unsigned vr, double value)
 {
     switch (vr) {
     case vr_tire_scale:
@@ -682,22 +682,22 @@ int model_set_real(ModelInstance *c, fmi2ValueReference vr, double value)
         c->s.w[vr - LCV_FIRST_INPUT] = value;
         return 0;
     }
-    snprintf(c->msg, sizeof c->msg, "fmi2SetReal: %u is not the value reference of an input or a Real parameter",
+    snprintf(c->msg, sizeof c->msg, "%u is not the value reference of an input or a Real parameter",
              (unsigned)vr);
     return -1;
 }
 
-int model_get_string(ModelInstance *c, fmi2ValueReference vr, const char **value)
+int model_get_string(ModelInstance *c, unsigned vr, const char **value)
 {
 #if LCV_HAS_PRESET
     if (vr == vr_preset) { *value = c->s.preset; return 0; }
 #endif
     *value = "";
-    snprintf(c->msg, sizeof c->msg, "fmi2GetString: %u is not the value reference of a String variable", (unsigned)vr);
+    snprintf(c->msg, sizeof c->msg, "%u is not the value reference of a String variable", (unsigned)vr);
     return -1;
 }
 
-int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value)
+int model_set_string(ModelInstance *c, unsigned vr, const char *value)
 {
 #if LCV_HAS_PRESET
     if (vr == vr_preset) {
@@ -712,12 +712,12 @@ int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value)
     }
 #endif
     (void)value;
-    snprintf(c->msg, sizeof c->msg, "fmi2SetString: %u is not the value reference of a String variable", (unsigned)vr);
+    snprintf(c->msg, sizeof c->msg, "%u is not the value reference of a String variable", (unsigned)vr);
     return -1;
 }
 
 /* preset, the Enumeration (SPEC section 15): value k is the k-th preset, 1-based */
-int model_get_integer(ModelInstance *c, fmi2ValueReference vr, int *value)
+int model_get_integer(ModelInstance *c, unsigned vr, int *value)
 {
 #if LCV_HAS_PRESET
     if (vr == vr_preset) {
@@ -731,7 +731,7 @@ int model_get_integer(ModelInstance *c, fmi2ValueReference vr, int *value)
     return -1;
 }
 
-int model_set_integer(ModelInstance *c, fmi2ValueReference vr, long long value)
+int model_set_integer(ModelInstance *c, unsigned vr, long long value)
 {
 #if LCV_HAS_PRESET
     if (vr == vr_preset) {
@@ -795,9 +795,10 @@ int model_check_state(ModelInstance *c, const ModelState *s)
     return 0;
 }
 
-void model_state_restored(ModelInstance *c, int same_vehicle)
+void model_state_restored(ModelInstance *c, const ModelState *before)
 {
-    if (!same_vehicle) {
+    if (!(c->s.vehicle == before->vehicle && c->s.tire_scale == before->tire_scale &&
+          c->s.crossfall == before->crossfall)) {
         for (int i = 0; i < LCV_N_STEP_CACHE; ++i) c->steps[i].valid = 0;
         for (int i = 0; i < LCV_N_SPEED_CACHE; ++i) c->speeds[i].valid = 0;
     }

@@ -20,41 +20,41 @@ int model_exit_initialization(ModelInstance *c) { c->s.vehicle = 0; return 0; }
 
 int model_do_step(ModelInstance *c, double h) { c->s.time += h; return 0; }
 
-int model_get_real(ModelInstance *c, const fmi2ValueReference vr[], size_t nvr, double value[])
+int model_get_real(ModelInstance *c, const unsigned vr[], size_t nvr, double value[])
 {
     (void)c; (void)vr;
     for (size_t i = 0; i < nvr; ++i) value[i] = 0.0;
     return 0;
 }
 
-int model_set_real(ModelInstance *c, fmi2ValueReference vr, double value)
+int model_set_real(ModelInstance *c, unsigned vr, double value)
 {
     if (vr >= LCV_FIRST_INPUT && vr < LCV_FIRST_INPUT + LCV_N_INPUTS) c->s.w[vr - LCV_FIRST_INPUT] = value;
     return 0;
 }
 
-int model_get_string(ModelInstance *c, fmi2ValueReference vr, const char **value)
+int model_get_string(ModelInstance *c, unsigned vr, const char **value)
 {
     (void)vr;
     *value = c->s.preset;
     return 0;
 }
 
-int model_set_string(ModelInstance *c, fmi2ValueReference vr, const char *value)
+int model_set_string(ModelInstance *c, unsigned vr, const char *value)
 {
     (void)vr;
     snprintf(c->s.preset, sizeof c->s.preset, "%s", value ? value : "");
     return 0;
 }
 
-int model_get_integer(ModelInstance *c, fmi2ValueReference vr, int *value) { (void)c; (void)vr; *value = 1; return 0; }
+int model_get_integer(ModelInstance *c, unsigned vr, int *value) { (void)c; (void)vr; *value = 1; return 0; }
 
-int model_set_integer(ModelInstance *c, fmi2ValueReference vr, long long value)
+int model_set_integer(ModelInstance *c, unsigned vr, long long value)
 { (void)c; (void)vr; (void)value; return 0; }
 
 int model_check_state(ModelInstance *c, const ModelState *s) { (void)c; (void)s; return 0; }
 
-void model_state_restored(ModelInstance *c, int same_vehicle) { (void)c; (void)same_vehicle; }
+void model_state_restored(ModelInstance *c, const ModelState *before) { (void)c; (void)before; }
 
 void model_get_nominals(ModelInstance *c, double x[], size_t nx) { (void)c; for (size_t i = 0; i < nx; ++i) x[i] = 1.0; }
 void model_get_states(ModelInstance *c, double x[], size_t nx) { (void)c; for (size_t i = 0; i < nx; ++i) x[i] = 0.0; }

@@ -1,22 +1,22 @@
-/* Shared by the C FMU and the pythonfmu loader; see fmi2_shared.c. */
-#ifndef LCV_FMI2_SHARED_H
-#define LCV_FMI2_SHARED_H
+/* What every FMI API file of this tree shares, FMI-neutral (no FMI type): the API files over
+   any model (api/), the driver, and the Python FMUs' loaders (python/); see fmu_common.c. */
+#ifndef LCV_FMU_COMMON_H
+#define LCV_FMU_COMMON_H
 
 #include <stdarg.h>
 #include <stddef.h>
-
-#include "fmi2Functions.h"
 
 /* printf-format into out (size bytes) with every '%' doubled: the finished text is passed
    to the host's logger as the message itself, so hosts that apply printf formatting print
    it as is and hosts that do not (Python hosts) get the text. */
 void format_log_message(char *out, size_t size, const char *fmt, va_list ap);
 
-/* the FMI log category of a status: logStatusWarning, logStatusError or logAll */
-const char *log_category(fmi2Status status);
+/* the FMI log category of a status (FMI 2 and 3 number them alike: 0 OK, 1 Warning, 2 Discard,
+   3 Error, 4 Fatal): logStatusWarning, logStatusError or logAll */
+const char *log_category(int status);
 
-/* phases of the FMI 2.0 co-simulation state machine (bit masks, as Reference-FMUs): the C
-   FMU's and the loader's (the loader enforces the same machine in front of pythonfmu) */
+/* phases of the FMI state machine (bit masks, as Reference-FMUs): the C FMU's and the loaders'
+   (which enforce the same machine in front of pythonfmu and pythonfmu3) */
 typedef enum {
     PhaseInstantiated = 1 << 0,
     PhaseInitializationMode = 1 << 1,

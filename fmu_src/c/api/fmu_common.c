@@ -1,13 +1,13 @@
 /*
- * What the C FMU (fmi2_api.c) and the pythonfmu FMU's loader (loader.c) share: the
- * formatting of log messages, and the FMI 2.0 status queries that neither supports (no
- * asynchronous doStep, so no pending status to report: they check their arguments and
- * answer fmi2Discard; fmi2GetStatus and fmi2GetRealStatus, which do answer, are in
- * those files).
+ * What the FMI API files (api/), the driver and the Python FMUs' loaders (python/) share: the
+ * formatting of log messages, the phases' names, and -- in an FMI 2 binary -- the FMI 2.0
+ * status queries that none of them supports (no asynchronous doStep, so no pending status to
+ * report: they check their arguments and answer fmi2Discard; fmi2GetStatus and
+ * fmi2GetRealStatus, which do answer, are in the API files).
  */
 #include <stdio.h>
 
-#include "fmi2_shared.h"
+#include "fmu_common.h"
 
 void format_log_message(char *out, size_t size, const char *fmt, va_list ap)
 {
@@ -34,12 +34,14 @@ const char *phase_name(int phase)
     }
 }
 
-const char *log_category(fmi2Status status)
+const char *log_category(int status)
 {
-    return status == fmi2Warning ? "logStatusWarning" : status >= fmi2Error ? "logStatusError" : "logAll";
+    return status == 1 ? "logStatusWarning" : status >= 3 ? "logStatusError" : "logAll";
 }
 
 #ifndef LCV_FMI3          /* the FMI 3.0 binary exports no fmi2 function */
+#include "fmi2Functions.h"
+
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
 {
     (void)s;
