@@ -27,8 +27,8 @@ NATIVE_HEADERS = ("api/fmu_common.h", "vehicle/model.h", "vehicle/linalg.h", "ve
 LOADER_INCLUDE_DIRS = ("api", "python")
 LOADER_SOURCES = {2: ("python/loader.c", "python/pyruntime.c", "api/fmu_common.c"),
                   3: ("python/loader3.c", "python/pyruntime.c", "api/fmu_common.c")}
-LOADER_HEADERS = {2: ("python/pyruntime.h", "api/fmu_common.h"),
-                  3: ("python/pyruntime.h", "api/fmu_common.h", "api/fmi3_no_variables.h")}
+LOADER_HEADERS = {2: ("python/pyruntime.h", "python/loader_state.inc", "api/fmu_common.h"),
+                  3: ("python/pyruntime.h", "python/loader_state.inc", "api/fmu_common.h", "api/fmi3_no_variables.h")}
 #: the driver FMU (FMI 2)
 DRIVER_INCLUDE_DIRS = ("api",)
 DRIVER_SOURCES = ("driver/driver.c", "api/fmu_common.c")

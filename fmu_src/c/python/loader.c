@@ -38,6 +38,7 @@
 #define _POSIX_C_SOURCE 200809L   /* strdup */
 #include <ctype.h>
 #include <dlfcn.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -114,14 +115,6 @@ typedef struct {
     char *folder;                         /* the resources folder (taken off sys.path at the last free) */
     char *alias;                          /* a symlink to it pythonfmu reads as is, or NULL (pyruntime.h) */
 } Wrapper;
-
-/* an FMU state: pythonfmu's and the phase */
-#define LOADER_STATE_TAG 0x4C435653U      /* "LCVS" */
-typedef struct {
-    unsigned tag;
-    int phase;
-    fmi2FMUstate inner;
-} LoaderState;
 
 /* ------------------------------------------------------------------ the resource location */
 static int hex_value(char c)
@@ -480,137 +473,63 @@ NO_VARIABLES(fmi2GetBoolean, "Boolean", fmi2Boolean)
 NO_VARIABLES(fmi2SetBoolean, "Boolean", const fmi2Boolean)
 
 /* ------------------------------------------------------------------ FMU state */
-static LoaderState *own_state(Wrapper *w, fmi2FMUstate state, const char *function)
-{
-    LoaderState *s = (LoaderState *)state;
-    if (!s || s->tag != LOADER_STATE_TAG) {
-        say(w, fmi2Error, "%s: the FMU state was not made by this FMU", function);
-        return NULL;
-    }
-    return s;
-}
+/* pythonfmu's state of the slave and the phase (loader_state.inc, shared with loader3.c) */
+#define LS_STATE fmi2FMUstate
+#define LS_STATUS fmi2Status
+#define LS_BYTE fmi2Byte
+#define LS_OK fmi2OK
+#define LS_WARNING fmi2Warning
+#define LS_ERROR fmi2Error
+#define LS_TAG 0x4C435653U                /* "LCVS" */
+#define LS_KEEPS_TIME 0
+#define LS_GET p_fmi2GetFMUstate
+#define LS_SET p_fmi2SetFMUstate
+#define LS_FREE p_fmi2FreeFMUstate
+#define LS_SIZE p_fmi2SerializedFMUstateSize
+#define LS_SERIALIZE p_fmi2SerializeFMUstate
+#define LS_DESERIALIZE p_fmi2DeSerializeFMUstate
+#include "loader_state.inc"
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
 {
     Wrapper *w = (Wrapper *)c;
     if (!USABLE(fmi2GetFMUstate)) return fmi2Error;
-    if (!state) { say(w, fmi2Error, "fmi2GetFMUstate: null pointer"); return fmi2Error; }
-    LoaderState *s = NULL;
-    if (*state) {                  /* the same slot again: replace what it holds */
-        if (!(s = own_state(w, *state, "fmi2GetFMUstate"))) return fmi2Error;
-        if (s->inner) {
-            fmi2Status f = outcome(w, p_fmi2FreeFMUstate(w->inner, &s->inner), "fmi2GetFMUstate");
-            s->inner = NULL;
-            if (f > fmi2Warning) return f;
-        }
-    } else if (!(s = (LoaderState *)calloc(1, sizeof *s))) {
-        say(w, fmi2Error, "fmi2GetFMUstate: out of memory");
-        return fmi2Error;
-    }
-    s->tag = LOADER_STATE_TAG;
-    fmi2FMUstate inner = NULL;
-    fmi2Status r = outcome(w, p_fmi2GetFMUstate(w->inner, &inner), "fmi2GetFMUstate");
-    s->inner = inner;
-    s->phase = w->phase;
-    *state = s;
-    return r;
+    return state_get(w, state, "fmi2GetFMUstate");
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state)
 {
     Wrapper *w = (Wrapper *)c;
     if (!USABLE(fmi2SetFMUstate)) return fmi2Error;
-    if (!state) { say(w, fmi2Error, "fmi2SetFMUstate: null state"); return fmi2Error; }
-    LoaderState *s = own_state(w, state, "fmi2SetFMUstate");
-    if (!s || !s->inner) return fmi2Error;
-    fmi2Status r = outcome(w, p_fmi2SetFMUstate(w->inner, s->inner), "fmi2SetFMUstate");
-    if (r <= fmi2Warning) w->phase = s->phase;
-    return r;
+    return state_set(w, state, "fmi2SetFMUstate");
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
 {
     Wrapper *w = (Wrapper *)c;
     if (!USABLE(fmi2FreeFMUstate)) return fmi2Error;
-    if (!state) { say(w, fmi2Error, "fmi2FreeFMUstate: null pointer"); return fmi2Error; }
-    if (!*state) return fmi2OK;
-    LoaderState *s = own_state(w, *state, "fmi2FreeFMUstate");
-    if (!s) return fmi2Error;
-    fmi2Status r = fmi2OK;
-    if (s->inner) r = outcome(w, p_fmi2FreeFMUstate(w->inner, &s->inner), "fmi2FreeFMUstate");
-    s->tag = 0;
-    free(s);
-    *state = NULL;
-    return r;
+    return state_free(w, state, "fmi2FreeFMUstate");
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size)
 {
     Wrapper *w = (Wrapper *)c;
     if (!USABLE(fmi2SerializedFMUstateSize)) return fmi2Error;
-    if (!state || !size) { say(w, fmi2Error, "fmi2SerializedFMUstateSize: null pointer"); return fmi2Error; }
-    LoaderState *s = own_state(w, state, "fmi2SerializedFMUstateSize");
-    if (!s || !s->inner) return fmi2Error;
-    size_t inner = 0;
-    fmi2Status r = outcome(w, p_fmi2SerializedFMUstateSize(w->inner, s->inner, &inner), "fmi2SerializedFMUstateSize");
-    *size = inner + 1;             /* one byte more: the phase */
-    return r;
+    return state_size(w, state, size, "fmi2SerializedFMUstateSize");
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size)
 {
     Wrapper *w = (Wrapper *)c;
     if (!USABLE(fmi2SerializeFMUstate)) return fmi2Error;
-    if (!state || !bytes) { say(w, fmi2Error, "fmi2SerializeFMUstate: null pointer"); return fmi2Error; }
-    LoaderState *s = own_state(w, state, "fmi2SerializeFMUstate");
-    if (!s || !s->inner) return fmi2Error;
-    size_t need = 0;
-    if (p_fmi2SerializedFMUstateSize(w->inner, s->inner, &need) != fmi2OK || need + 1 > size) {
-        say(w, fmi2Error, "fmi2SerializeFMUstate: %u bytes given, %u needed", (unsigned)size, (unsigned)need + 1);
-        return fmi2Error;
-    }
-    fmi2Status r = outcome(w, p_fmi2SerializeFMUstate(w->inner, s->inner, bytes, need), "fmi2SerializeFMUstate");
-    int bit = 0;
-    while (bit < 5 && (1 << bit) != s->phase) ++bit;
-    bytes[need] = (fmi2Byte)('0' + bit);
-    return r;
+    return state_serialize(w, state, bytes, size, "fmi2SerializeFMUstate");
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate *state)
 {
     Wrapper *w = (Wrapper *)c;
     if (!USABLE(fmi2DeSerializeFMUstate)) return fmi2Error;
-    if (!bytes || !state) { say(w, fmi2Error, "fmi2DeSerializeFMUstate: null pointer"); return fmi2Error; }
-    size_t magic = strlen(LOADER_STATE_MAGIC);
-    if (size < magic + 1 || size > LOADER_STATE_MAX_BYTES || memcmp(bytes, LOADER_STATE_MAGIC, magic) != 0 ||
-        bytes[size - 1] < '0' || bytes[size - 1] > '4') {
-        say(w, fmi2Error, "fmi2DeSerializeFMUstate: %u bytes that are not an FMU state written by this FMU",
-            (unsigned)size);
-        return fmi2Error;
-    }
-    LoaderState *s = (LoaderState *)*state;
-    if (s && !own_state(w, s, "fmi2DeSerializeFMUstate")) return fmi2Error;
-    fmi2FMUstate inner = NULL;
-    fmi2Status r = outcome(w, p_fmi2DeSerializeFMUstate(w->inner, bytes, size - 1, &inner),
-                           "fmi2DeSerializeFMUstate");
-    if (r > fmi2Warning) {
-        if (inner) p_fmi2FreeFMUstate(w->inner, &inner);
-        return r;
-    }
-    if (!s) {
-        if (!(s = (LoaderState *)calloc(1, sizeof *s))) {
-            p_fmi2FreeFMUstate(w->inner, &inner);
-            say(w, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
-            return fmi2Error;
-        }
-    } else if (s->inner) {
-        p_fmi2FreeFMUstate(w->inner, &s->inner);
-    }
-    s->tag = LOADER_STATE_TAG;
-    s->inner = inner;
-    s->phase = 1 << (bytes[size - 1] - '0');
-    *state = s;
-    return r;
+    return state_deserialize(w, bytes, size, state, "fmi2DeSerializeFMUstate");
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,

@@ -77,16 +77,6 @@ typedef struct {
     char *alias;                          /* a symlink to it pythonfmu3 reads as is, or NULL (pyruntime.h) */
 } Wrapper;
 
-#define LOADER_STATE_TAG 0x4C435633U      /* "LCV3" */
-typedef struct {
-    unsigned tag;
-    int phase;
-    double time;                          /* the independent variable, which the loader keeps */
-    fmi3FMUState inner;
-} LoaderState;
-/* a serialized state: pythonfmu3's bytes, the time (8 bytes), the phase (one digit) */
-#define LOADER_STATE_TRAILER (sizeof(double) + 1)
-
 /* ------------------------------------------------------------------ logging */
 static void say(Wrapper *w, fmi3Status status, const char *fmt, ...)
 {
@@ -714,145 +704,57 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueRefere
 }
 
 /* ------------------------------------------------------------------ FMU state */
-static LoaderState *own_state(Wrapper *w, fmi3FMUState state, const char *function)
-{
-    LoaderState *s = (LoaderState *)state;
-    if (!s || s->tag != LOADER_STATE_TAG) {
-        say(w, fmi3Error, "%s: the FMU state was not made by this FMU", function);
-        return NULL;
-    }
-    return s;
-}
+/* pythonfmu3's state of the slave, the phase and the time (loader_state.inc, shared with loader.c) */
+#define LS_STATE fmi3FMUState
+#define LS_STATUS fmi3Status
+#define LS_BYTE fmi3Byte
+#define LS_OK fmi3OK
+#define LS_WARNING fmi3Warning
+#define LS_ERROR fmi3Error
+#define LS_TAG 0x4C435633U                /* "LCV3" */
+#define LS_KEEPS_TIME 1
+#define LS_GET p_fmi3GetFMUState
+#define LS_SET p_fmi3SetFMUState
+#define LS_FREE p_fmi3FreeFMUState
+#define LS_SIZE p_fmi3SerializedFMUStateSize
+#define LS_SERIALIZE p_fmi3SerializeFMUState
+#define LS_DESERIALIZE p_fmi3DeserializeFMUState
+#include "loader_state.inc"
 
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
     BEGIN(fmi3GetFMUState, ANY_PHASE)
-    if (!FMUState) { say(w, fmi3Error, "fmi3GetFMUState: null pointer"); return fmi3Error; }
-    LoaderState *s = NULL;
-    if (*FMUState) {               /* the same slot again: replace what it holds */
-        if (!(s = own_state(w, *FMUState, "fmi3GetFMUState"))) return fmi3Error;
-        if (s->inner) {
-            fmi3Status f = outcome(w, p_fmi3FreeFMUState(w->inner, &s->inner), "fmi3GetFMUState");
-            s->inner = NULL;
-            if (f > fmi3Warning) return f;
-        }
-    } else if (!(s = (LoaderState *)calloc(1, sizeof *s))) {
-        say(w, fmi3Error, "fmi3GetFMUState: out of memory");
-        return fmi3Error;
-    }
-    s->tag = LOADER_STATE_TAG;
-    fmi3FMUState inner = NULL;
-    fmi3Status r = outcome(w, p_fmi3GetFMUState(w->inner, &inner), "fmi3GetFMUState");
-    s->inner = inner;
-    s->phase = w->phase;
-    s->time = w->time;
-    *FMUState = s;
-    return r;
+    return state_get(w, FMUState, "fmi3GetFMUState");
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
 {
     BEGIN(fmi3SetFMUState, ANY_PHASE)
-    if (!FMUState) { say(w, fmi3Error, "fmi3SetFMUState: null state"); return fmi3Error; }
-    LoaderState *s = own_state(w, FMUState, "fmi3SetFMUState");
-    if (!s || !s->inner) return fmi3Error;
-    fmi3Status r = outcome(w, p_fmi3SetFMUState(w->inner, s->inner), "fmi3SetFMUState");
-    if (r <= fmi3Warning) {
-        w->phase = s->phase;
-        w->time = s->time;
-    }
-    return r;
+    return state_set(w, FMUState, "fmi3SetFMUState");
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
     BEGIN(fmi3FreeFMUState, ANY_PHASE)
-    if (!FMUState) { say(w, fmi3Error, "fmi3FreeFMUState: null pointer"); return fmi3Error; }
-    if (!*FMUState) return fmi3OK;
-    LoaderState *s = own_state(w, *FMUState, "fmi3FreeFMUState");
-    if (!s) return fmi3Error;
-    fmi3Status r = fmi3OK;
-    if (s->inner) r = outcome(w, p_fmi3FreeFMUState(w->inner, &s->inner), "fmi3FreeFMUState");
-    s->tag = 0;
-    free(s);
-    *FMUState = NULL;
-    return r;
+    return state_free(w, FMUState, "fmi3FreeFMUState");
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size)
 {
     BEGIN(fmi3SerializedFMUStateSize, ANY_PHASE)
-    if (!FMUState || !size) { say(w, fmi3Error, "fmi3SerializedFMUStateSize: null pointer"); return fmi3Error; }
-    LoaderState *s = own_state(w, FMUState, "fmi3SerializedFMUStateSize");
-    if (!s || !s->inner) return fmi3Error;
-    size_t inner = 0;
-    fmi3Status r = outcome(w, p_fmi3SerializedFMUStateSize(w->inner, s->inner, &inner), "fmi3SerializedFMUStateSize");
-    *size = inner + LOADER_STATE_TRAILER;     /* more: the time and the phase */
-    return r;
+    return state_size(w, FMUState, size, "fmi3SerializedFMUStateSize");
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[],
                                  size_t size)
 {
     BEGIN(fmi3SerializeFMUState, ANY_PHASE)
-    if (!FMUState || !serializedState) { say(w, fmi3Error, "fmi3SerializeFMUState: null pointer"); return fmi3Error; }
-    LoaderState *s = own_state(w, FMUState, "fmi3SerializeFMUState");
-    if (!s || !s->inner) return fmi3Error;
-    size_t need = 0;
-    if (p_fmi3SerializedFMUStateSize(w->inner, s->inner, &need) != fmi3OK || need + LOADER_STATE_TRAILER > size) {
-        say(w, fmi3Error, "fmi3SerializeFMUState: %u bytes given, %u needed", (unsigned)size,
-            (unsigned)(need + LOADER_STATE_TRAILER));
-        return fmi3Error;
-    }
-    fmi3Status r = outcome(w, p_fmi3SerializeFMUState(w->inner, s->inner, serializedState, need),
-                           "fmi3SerializeFMUState");
-    memcpy(serializedState + need, &s->time, sizeof(double));
-    int bit = 0;
-    while (bit < 5 && (1 << bit) != s->phase) ++bit;
-    serializedState[need + sizeof(double)] = (fmi3Byte)('0' + bit);
-    return r;
+    return state_serialize(w, FMUState, serializedState, size, "fmi3SerializeFMUState");
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
                                    fmi3FMUState *FMUState)
 {
     BEGIN(fmi3DeserializeFMUState, ANY_PHASE)
-    if (!serializedState || !FMUState) {
-        say(w, fmi3Error, "fmi3DeserializeFMUState: null pointer");
-        return fmi3Error;
-    }
-    size_t magic = strlen(LOADER_STATE_MAGIC);
-    double time = 0.0;
-    if (size >= magic + LOADER_STATE_TRAILER) memcpy(&time, serializedState + size - LOADER_STATE_TRAILER, sizeof time);
-    if (size < magic + LOADER_STATE_TRAILER || size > LOADER_STATE_MAX_BYTES ||
-        memcmp(serializedState, LOADER_STATE_MAGIC, magic) != 0 || serializedState[size - 1] < '0' ||
-        serializedState[size - 1] > '4' || !isfinite(time)) {
-        say(w, fmi3Error, "fmi3DeserializeFMUState: %u bytes that are not an FMU state written by this FMU",
-            (unsigned)size);
-        return fmi3Error;
-    }
-    LoaderState *s = (LoaderState *)*FMUState;
-    if (s && !own_state(w, s, "fmi3DeserializeFMUState")) return fmi3Error;
-    fmi3FMUState inner = NULL;
-    fmi3Status r = outcome(w, p_fmi3DeserializeFMUState(w->inner, serializedState, size - LOADER_STATE_TRAILER,
-                                                        &inner), "fmi3DeserializeFMUState");
-    if (r > fmi3Warning) {
-        if (inner) p_fmi3FreeFMUState(w->inner, &inner);
-        return r;
-    }
-    if (!s) {
-        if (!(s = (LoaderState *)calloc(1, sizeof *s))) {
-            p_fmi3FreeFMUState(w->inner, &inner);
-            say(w, fmi3Error, "fmi3DeserializeFMUState: out of memory");
-            return fmi3Error;
-        }
-    } else if (s->inner) {
-        p_fmi3FreeFMUState(w->inner, &s->inner);
-    }
-    s->tag = LOADER_STATE_TAG;
-    s->inner = inner;
-    s->phase = 1 << (serializedState[size - 1] - '0');
-    s->time = time;
-    *FMUState = s;
-    return r;
+    return state_deserialize(w, serializedState, size, FMUState, "fmi3DeserializeFMUState");
 }
