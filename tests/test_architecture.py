@@ -272,3 +272,24 @@ def test_the_code_cites_pages_a_reader_has():
             elif anchor and anchor not in anchors(page):
                 bad.append((module, f"{page}#{anchor}"))
     assert not bad, bad
+
+
+def test_the_c_tree_has_the_fmi_api_once_per_version():
+    """As Reference-FMUs has it: the FMI functions are defined in api/ (once per version, over any
+    model) and in the Python FMUs' loaders (python/), nowhere else; the models (vehicle/, driver/)
+    are FMI-neutral -- no FMI header, type or function name in their code."""
+    import re
+    c = PACKAGE.parent / "fmu_src" / "c"
+    definition = re.compile(r"^[A-Za-z0-9_ *]*\b(fmi[23][A-Z]\w*)\s*\(", re.M)
+    defined = {}
+    for path in sorted(c.rglob("*.c")):
+        for name in definition.findall(path.read_text()):
+            defined.setdefault(name, []).append(path.relative_to(c).parts[0])
+    assert defined, "no FMI function found: the pattern is wrong"
+    assert {folder for folders in defined.values() for folder in folders} == {"api", "python"}
+    api = {name: [f for f in folders if f == "api"] for name, folders in defined.items()}
+    assert all(len(f) <= 1 for f in api.values()), {n: f for n, f in api.items() if len(f) > 1}
+    for folder in ("vehicle", "driver"):
+        for path in (c / folder).iterdir():
+            code = re.sub(r"/\*.*?\*/", "", path.read_text(), flags=re.S)       # comments may name the API
+            assert not re.search(r"fmi[23]", code), f"{path.relative_to(c)} is not FMI-neutral"

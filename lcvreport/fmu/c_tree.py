@@ -21,7 +21,7 @@ NATIVE_SOURCES = {2: ("api/fmi2_api.c", "api/fmu_common.c", "vehicle/model.c", "
 #: the interface-only twin of the FMI 2 native FMU (no model: benchmarks)
 STUB_SOURCES = ("api/fmi2_api.c", "api/fmu_common.c", "vehicle/model_stub.c")
 #: the headers shipped in a native FMU's sources/
-NATIVE_HEADERS = ("api/fmu_common.h", "vehicle/model.h", "vehicle/linalg.h", "vehicle/vehicle.h",
+NATIVE_HEADERS = ("api/fmu_common.h", "api/model_api.h", "vehicle/model.h", "vehicle/linalg.h", "vehicle/vehicle.h",
                   "api/fmi3_no_variables.h")
 #: the Python FMUs' loaders per FMI version: sources, and the headers shipped beside them
 LOADER_INCLUDE_DIRS = ("api", "python")
@@ -29,10 +29,10 @@ LOADER_SOURCES = {2: ("python/loader.c", "python/pyruntime.c", "api/fmu_common.c
                   3: ("python/loader3.c", "python/pyruntime.c", "api/fmu_common.c")}
 LOADER_HEADERS = {2: ("python/pyruntime.h", "python/loader_state.inc", "api/fmu_common.h"),
                   3: ("python/pyruntime.h", "python/loader_state.inc", "api/fmu_common.h", "api/fmi3_no_variables.h")}
-#: the driver FMU (FMI 2)
-DRIVER_INCLUDE_DIRS = ("api",)
-DRIVER_SOURCES = ("driver/driver.c", "api/fmu_common.c")
-DRIVER_HEADERS = ("api/fmu_common.h",)
+#: the driver FMU (FMI 2): the driver model behind the same API file as the vehicle's
+DRIVER_INCLUDE_DIRS = ("api", "driver")
+DRIVER_SOURCES = ("api/fmi2_api.c", "api/fmu_common.c", "driver/driver.c")
+DRIVER_HEADERS = ("api/fmu_common.h", "api/model_api.h", "driver/model.h")
 
 
 def names(paths) -> tuple[str, ...]:

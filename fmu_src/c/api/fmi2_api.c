@@ -341,7 +341,7 @@ static int states_arg(Instance2 *c, const char *function, const void *x, size_t 
         logmsg(c, fmi2Error, "%s: %u states given, this FMU has %u", function, (unsigned)nx, (unsigned)LCV_N_ME_STATES);
         return 0;
     }
-    if (!x) { logmsg(c, fmi2Error, "%s: null array", function); return 0; }
+    if (nx > 0 && !x) { logmsg(c, fmi2Error, "%s: null array", function); return 0; }
     return 1;
 }
 

@@ -73,30 +73,10 @@ const char *model_variable_name(unsigned vr);
 unsigned model_me_state_vr(size_t k);
 #define LCV_ME_STATE_VR_OF(k) model_me_state_vr(k)
 
-/* the model API: 0 on success, 1 success with a warning in c->msg, -1 error in c->msg */
-void model_reset(ModelInstance *c);
-int model_exit_initialization(ModelInstance *c);
-int model_do_step(ModelInstance *c, double h);
-int model_get_real(ModelInstance *c, const unsigned vr[], size_t nvr, double value[]);
-int model_set_real(ModelInstance *c, unsigned vr, double value);
-int model_get_string(ModelInstance *c, unsigned vr, const char **value);
-int model_set_string(ModelInstance *c, unsigned vr, const char *value);
-int model_get_integer(ModelInstance *c, unsigned vr, int *value);
-int model_set_integer(ModelInstance *c, unsigned vr, long long value);
-/* Model Exchange (SPEC section 15): the continuous states of the interface (v1, r.., theta..,
-   psi1, Y1; 0 for what the vehicle lacks) and their derivatives at the current inputs */
-void model_get_states(ModelInstance *c, double x[], size_t nx);
-/* their nominals: each state's physical scale (the peak of the standard single sine), for a host's tolerances */
-void model_get_nominals(ModelInstance *c, double x[], size_t nx);
-void model_set_states(ModelInstance *c, const double x[], size_t nx);
-int model_derivatives(ModelInstance *c, double dx[], size_t nx);
-/* directional derivatives of derivatives and outputs with respect to states and inputs other than u */
-int model_directional(ModelInstance *c, const unsigned unknowns[], size_t nu, const unsigned knowns[], size_t nk,
-                      const double seed[], double out[]);
-/* 0 if a snapshot is acceptable for this instance, else -1 with c->msg */
-int model_check_state(ModelInstance *c, const ModelState *s);
-/* after a snapshot was restored over the state ``before``: drop the caches if the vehicle, the
-   tire scale or the crossfall changed */
-void model_state_restored(ModelInstance *c, const ModelState *before);
+/* the model API (api/model_api.h); here: the Model Exchange states are the interface's (v1, r..,
+   theta.., psi1, Y1; 0 for what the vehicle lacks), their nominals the peaks of the standard single
+   sine; directional derivatives are with respect to states and inputs other than u; a restored FMU
+   state drops the caches if the vehicle, the tire scale or the crossfall changed */
+#include "model_api.h"
 
 #endif
