@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import ctypes
+import html
 import shutil
 import subprocess
 import sys
@@ -105,6 +106,10 @@ def test_every_python_fmi3_fmu_validates(python3_fmu, example3_python_fmus):
         assert {f"binaries/x86_64-linux/{fmu.stem}.so", "binaries/x86_64-linux/libpythonfmu3-export.so",
                 "documentation/index.html", "documentation/licenses/license.txt"} <= set(names)
         assert (root.find("ModelVariables/Enumeration[@name='preset']") is not None) == (fmu == python3_fmu)
+        doc = html.unescape(zipfile.ZipFile(fmu).read("documentation/index.html").decode())
+        lic = zipfile.ZipFile(fmu).read("documentation/licenses/license.txt").decode()
+        assert "FMI 3.0 Co-Simulation FMU" in doc and "pythonfmu3's export library" in doc
+        assert "pythonfmu3 0.3.4 (resources/pythonfmu3, binaries/x86_64-linux/libpythonfmu3-export.so)" in lic
 
 
 @pytest.mark.parametrize("preset", ["aucnat", "tractor_semitrailer"])

@@ -104,8 +104,10 @@ def test_documentation_with_dependencies_and_licenses(every_fmu):
         assert "MIT License" in lic
         if native:
             assert "C library and libm" in index
+            assert "FMI 2.0 Co-Simulation and Model Exchange FMU" in index, name     # both interfaces
         else:
-            assert "CPython 3.11" in index and "numpy" in index and "pythonfmu" in lic
+            assert "CPython 3.11" in index and "numpy" in index and "pythonfmu 0.7.0" in lic
+            assert "FMI 2.0 Co-Simulation FMU" in index, name
 
 
 def test_display_units_and_quantities(every_fmu, all_example_fmus):

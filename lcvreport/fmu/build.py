@@ -36,7 +36,7 @@ from pathlib import Path
 
 from ..model.vehicle import Vehicle
 from ..model.vehicle_file import dumps_vehicle
-from .c_sources import (EXPORT_LIB, FmuBuildError, _c_string, _compile, c_files, config_data_header, config_header,
+from .c_sources import (EXPORT_LIB, EXPORT_LIBS, FmuBuildError, _compile, c_files, config_data_header, config_header,
                         fmi_header_dir, loader_config_header, shipped_sources, source_dir, vehicle_data_header)
 from .c_tree import (INCLUDE_DIRS, LOADER_HEADERS, LOADER_INCLUDE_DIRS, LOADER_SOURCES, NATIVE_HEADERS, NATIVE_SOURCES,
                      STUB_SOURCES)
@@ -103,11 +103,7 @@ def build_native_fmu3(itf: Interface, out_dir: Path, model_identifier: str) -> P
             files[f"sources/{name}"] = text.encode()
         if not itf.preset_mode:
             files["resources/vehicle.toml"] = dumps_vehicle(itf.vehicles[0]).encode()
-        doc = documentation_files(itf, model_identifier, native=True)
-        doc["documentation/index.html"] = doc["documentation/index.html"].replace(b"FMI 2.0 Co-Simulation FMU",
-                                                                                  b"FMI 3.0 Co-Simulation and Model "
-                                                                                  b"Exchange FMU")
-        files.update(doc)
+        files.update(documentation_files(itf, model_identifier, native=True, fmi=3))
         return _zip(out_dir / f"{model_identifier}.fmu", files)
 
 
@@ -182,7 +178,7 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
 
 
 #: pythonfmu3's export library inside the FMI 3.0 Python FMU (the loader, loader3.c, loads it)
-EXPORT_LIB3 = "libpythonfmu3-export.so"
+EXPORT_LIB3 = EXPORT_LIBS[3]
 
 
 SLAVE3_TEMPLATE = '''"""The slave module pythonfmu3 imports from the FMU's resources (once per process, under this
@@ -216,11 +212,7 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
                                          model_identifier, "x86_64-linux")
         files["modelDescription.xml"] = model_description3(itf, model_identifier, native=False,
                                                            generation_tool="lcvreport.fmu.build (pythonfmu3 0.3.4)")
-        from .description_fmi3 import time_value_reference
-        config = loader_config_header(itf, model_identifier, fmu_guid, env).replace(
-            f"#define LOADER_EXPORT_LIB {_c_string(EXPORT_LIB)}", f"#define LOADER_EXPORT_LIB {_c_string(EXPORT_LIB3)}")
-        config = config.replace("#endif", f"#define LOADER_TIME_VR {time_value_reference(itf)}\n#endif")
-        (tmp / "loader_config.h").write_text(config, "utf-8")
+        (tmp / "loader_config.h").write_text(loader_config_header(itf, model_identifier, fmu_guid, env, fmi=3), "utf-8")
         loader = tmp / f"{model_identifier}.so"
         _compile(c_files(LOADER_SOURCES[3]),
                  [tmp, *c_files(LOADER_INCLUDE_DIRS), fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
@@ -229,13 +221,7 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
         files[f"binaries/x86_64-linux/{EXPORT_LIB3}"] = export
         files.update(shipped_sources(LOADER_SOURCES[3] + LOADER_HEADERS[3]))
         files["sources/loader_config.h"] = (tmp / "loader_config.h").read_bytes()
-        doc = documentation_files(itf, model_identifier, native=False)
-        doc["documentation/index.html"] = doc["documentation/index.html"].replace(
-            b"FMI 2.0 Co-Simulation FMU", b"FMI 3.0 Co-Simulation FMU").replace(b"pythonfmu's", b"pythonfmu3's")
-        doc["documentation/licenses/license.txt"] = doc["documentation/licenses/license.txt"].replace(
-            b"pythonfmu 0.7.0 (resources/pythonfmu, binaries/linux64/pythonfmu-export.so)",
-            b"pythonfmu3 0.3.4 (resources/pythonfmu3, binaries/x86_64-linux/libpythonfmu3-export.so)")
-        files.update(doc)
+        files.update(documentation_files(itf, model_identifier, native=False, fmi=3))
         return _zip(out_dir / f"{model_identifier}.fmu", files)
 
 

@@ -37,7 +37,7 @@ DOC_INDEX = """<!DOCTYPE html>
 <body>
 <h1>{identifier}</h1>
 <p>{description}</p>
-<p>FMI 2.0 Co-Simulation FMU built by lcvreport {version}. Variables, units and valid ranges:
+<p>{kind} FMU built by lcvreport {version}. Variables, units and valid ranges:
 modelDescription.xml (every input and parameter carries the min and max the FMU enforces).</p>
 <h2>What it needs at run time</h2>
 <p>{needs}</p>
@@ -54,7 +54,11 @@ NEEDS_NATIVE = ("Nothing but the C library and libm: the model is compiled in (s
 NEEDS_PYTHON = ("A CPython 3.11 with numpy (the FMU sets needsExecutionTool=\"true\"): by default the interpreter "
                 "that built it; elsewhere set LCV_FMU_LIBPYTHON to its libpython3.11.so and, if needed, "
                 "LCV_FMU_PYTHONHOME and LCV_FMU_SITE_PACKAGES (numpy). resources/ carries the lcvreport package "
-                "and pythonfmu's export library; the C loader in binaries/ starts the interpreter.")
+                "and {tool}'s export library; the C loader in binaries/ starts the interpreter.")
+
+#: the tool behind each version's Python FMU: (name, version, its resources and export library)
+PYTHON_TOOLS = {2: ("pythonfmu", "0.7.0", "resources/pythonfmu, binaries/linux64/pythonfmu-export.so"),
+                3: ("pythonfmu3", "0.3.4", "resources/pythonfmu3, binaries/x86_64-linux/libpythonfmu3-export.so")}
 
 
 LICENSE_TEXT = """lcvreport (the model, the C sources, the loader): MIT License.
@@ -80,20 +84,25 @@ THE USE OR OTHER DEALINGS IN THE SOFTWARE.
 
 PYTHON_LICENSES = """
 Also in this FMU (Python FMU only):
-- pythonfmu 0.7.0 (resources/pythonfmu, binaries/linux64/pythonfmu-export.so): MIT License,
+- {tool} {tool_version} ({tool_files}): MIT License,
   https://github.com/NTNU-IHB/PythonFMU
 External dependencies, not shipped: CPython 3.11 (PSF License), numpy (BSD 3-Clause).
 """
 
 
-def documentation_files(itf: Interface, model_identifier: str, native: bool) -> dict:
-    """``documentation/index.html`` and ``documentation/licenses/license.txt`` of an FMU."""
+def documentation_files(itf: Interface, model_identifier: str, native: bool, fmi: int = 2) -> dict:
+    """``documentation/index.html`` and ``documentation/licenses/license.txt`` of an FMU: a native
+    one (Co-Simulation and Model Exchange) or a Python one (Co-Simulation) of FMI version ``fmi``."""
     import html
     from importlib.metadata import version
+    tool, tool_version, tool_files = PYTHON_TOOLS[fmi]
+    kind = f"FMI {fmi}.0 " + ("Co-Simulation and Model Exchange" if native else "Co-Simulation")
+    needs = NEEDS_NATIVE if native else NEEDS_PYTHON.format(tool=tool)
     index = DOC_INDEX.format(identifier=html.escape(model_identifier), description=html.escape(itf.description),
-                             version=version("lcvreport"), needs=html.escape(NEEDS_NATIVE if native else NEEDS_PYTHON))
-    return {"documentation/index.html": index.encode(),
-            "documentation/licenses/license.txt": (LICENSE_TEXT + ("" if native else PYTHON_LICENSES)).encode()}
+                             kind=kind, version=version("lcvreport"), needs=html.escape(needs))
+    licenses = LICENSE_TEXT + ("" if native else PYTHON_LICENSES.format(tool=tool, tool_version=tool_version,
+                                                                       tool_files=tool_files))
+    return {"documentation/index.html": index.encode(), "documentation/licenses/license.txt": licenses.encode()}
 
 
 def _zip(path: Path, files: dict[str, bytes]) -> Path:
