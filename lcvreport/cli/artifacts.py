@@ -12,6 +12,25 @@ from .options import UsageError, _load_units, _sources, _speed_mps, _vehicle
 from .output import OutputError, _Out
 
 
+def run_report(command: str, build, wrote) -> None:
+    """Build a report (``build()`` returns the paths it wrote by kind), turn its refusals into the
+    CLI's (a bad output folder: usage, exit 2; a failed build: exit 1), name what it wrote through
+    ``wrote`` and its time on stderr."""
+    from ..report.notebooks import ReportError
+    from ..report.publish import OutputFolderError
+    t0 = time.perf_counter()
+    try:
+        res = build()
+    except OutputFolderError as exc:
+        raise UsageError(f"argument {exc}") from None
+    except ReportError as exc:
+        raise OutputError(str(exc)) from None
+    for key in ("html", "pdf", "data"):
+        if key in res:
+            wrote(f"wrote {res[key]}")
+    print(f"{command}: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+
+
 def _cmd_fmu(args, out: _Out) -> int:
     from ..fmu.build import build_vehicle_fmus
     from ..fmu.c_sources import FmuBuildError
@@ -37,7 +56,6 @@ def _cmd_fmu(args, out: _Out) -> int:
 
 def _cmd_report(args, out: _Out) -> int:
     from ..report.build import build_assessment
-    from ..report.notebooks import ReportError
     from ..report.publish import OutputFolderError, check_output_folder
     try:
         check_output_folder(args.out)          # before anything is computed
@@ -84,21 +102,11 @@ def _cmd_report(args, out: _Out) -> int:
     if args.vehicle is not None:               # the user's file as written, comments and all
         from ..model.vehicle_file import read_vehicle_text
         text = read_vehicle_text(args.vehicle)
-    t0 = time.perf_counter()
-    try:
-        res = build_assessment(v, args.out, speed_mps=speed, load_units=units, pdf=not args.no_pdf,
-                               progress=lambda text: print(f"lcv report: {text}", file=sys.stderr, flush=True),
-                               source=args.vehicle or f"preset {args.preset}", vehicle_text=text, paper=args.paper,
-                               residuals=residuals, criteria_file=args.criteria,
-                               tracking=tracking if tracking["tires"] or tracking["stats"] else None)
-    except OutputFolderError as exc:
-        raise UsageError(f"argument {exc}") from None
-    except ReportError as exc:
-        raise OutputError(str(exc)) from None
-    for key in ("html", "pdf", "data"):
-        if key in res:
-            out.line(f"wrote {res[key]}")
-    print(f"lcv report: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    run_report("lcv report", lambda: build_assessment(
+        v, args.out, speed_mps=speed, load_units=units, pdf=not args.no_pdf,
+        progress=lambda text: print(f"lcv report: {text}", file=sys.stderr, flush=True),
+        source=args.vehicle or f"preset {args.preset}", vehicle_text=text, paper=args.paper, residuals=residuals,
+        criteria_file=args.criteria, tracking=tracking if tracking["tires"] or tracking["stats"] else None), out.line)
     return 0
 
 

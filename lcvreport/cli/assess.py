@@ -46,12 +46,9 @@ def _cmd_assess(args, out: _Out) -> int:
 def _write_report(args, a) -> None:
     """The assessment report into ``--out`` (docs/assessment.md#report)."""
     import sys
-    import time
 
     from ..report.build import build_scheme_report
-    from ..report.notebooks import ReportError
-    from ..report.publish import OutputFolderError
-    from .output import OutputError
+    from .artifacts import run_report
     text = None
     if args.vehicle is not None:               # the user's file as written, comments and all
         from ..model.vehicle_file import read_vehicle_text
@@ -59,20 +56,11 @@ def _write_report(args, a) -> None:
     src = a.sources
     residuals = {"P_N": src.loads.P_N, "T_Nm": src.loads.T_Nm, "misalignment_rad": src.misalignment_rad} \
         if src else None
-    t0 = time.perf_counter()
-    try:
-        res = build_scheme_report(a.vehicle, args.scheme, args.out, a.tire_scale, a.load_units or None, residuals,
-                                  pdf=not args.no_pdf, paper=args.paper,
-                                  source=args.vehicle or f"preset {args.preset}", vehicle_text=text,
-                                  progress=lambda line: print(f"lcv assess: {line}", file=sys.stderr, flush=True))
-    except OutputFolderError as exc:
-        raise UsageError(f"argument {exc}") from None
-    except ReportError as exc:
-        raise OutputError(str(exc)) from None
-    for key in ("html", "pdf", "data"):
-        if key in res:
-            print(f"lcv assess: wrote {res[key]}", file=sys.stderr)
-    print(f"lcv assess: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    run_report("lcv assess", lambda: build_scheme_report(
+        a.vehicle, args.scheme, args.out, a.tire_scale, a.load_units or None, residuals, pdf=not args.no_pdf,
+        paper=args.paper, source=args.vehicle or f"preset {args.preset}", vehicle_text=text,
+        progress=lambda line: print(f"lcv assess: {line}", file=sys.stderr, flush=True)),
+        lambda line: print(f"lcv assess: {line}", file=sys.stderr))
 
 
 def verdict_lines(a) -> list[str]:

@@ -178,29 +178,31 @@ ASSESSMENT = NotebookSpec("assessment", "assessment", "Yaw-plane and roll assess
                            "speed_kph": _speed(1 / MPS_PER_KPH, "km/h"), "load_units": _load_units})
 
 
-def _study_dir(name, value, _ctx):
-    from ..study.results import stored_study
-    from ..study.spec import StudyError
-    if not isinstance(value, str):
-        raise ReportError(f"parameter {name} must be the --out folder of lcv study, got {value!r}")
-    try:
-        stored_study(value)
-    except StudyError as exc:
-        raise ReportError(f"parameter {name}: {exc}") from None
+def _read_by(what: str, reader: str, refusal: str):
+    """A parameter naming ``what`` (a file or folder) that ``reader`` reads ("module:function" of
+    the package, imported on use), refused in one line with its reader's reason (``refusal``)."""
+    import importlib
+
+    def check(name, value, _ctx):
+        read_module, read_name = reader.split(":")
+        error_module, error_name = refusal.split(":")
+        error = getattr(importlib.import_module(error_module, __package__), error_name)
+        if not isinstance(value, str):
+            raise ReportError(f"parameter {name} must be {what}, got {value!r}")
+        try:
+            getattr(importlib.import_module(read_module, __package__), read_name)(value)
+        except error as exc:
+            raise ReportError(f"parameter {name} {value}: {exc}") from None
+    return check
 
 
 #: the study report's notebook
-STUDY = NotebookSpec("study", "study", "Study", {**_COMMON, "study_dir": _study_dir, "criteria_file": _text_or_none})
+STUDY = NotebookSpec("study", "study", "Study", {
+    **_COMMON, "study_dir": _read_by("the --out folder of lcv study", "..study.results:stored_study",
+                                     "..study.spec:StudyError"),
+    "criteria_file": _text_or_none})
 
-
-def _scheme_file(name, value, _ctx):
-    from ..measures.scheme import SchemeError, load_scheme
-    if not isinstance(value, str):
-        raise ReportError(f"parameter {name} must be the path of a scheme file, got {value!r}")
-    try:
-        load_scheme(value)
-    except SchemeError as exc:
-        raise ReportError(f"parameter {name} {value}: {exc}") from None
+_scheme_file = _read_by("the path of a scheme file", "..measures.scheme:load_scheme", "..measures.scheme:SchemeError")
 
 
 def _tire_scale(name, value, _ctx):
