@@ -8,6 +8,9 @@ once): what the roll families add to ``measure_set``.  Best of ``REPEATS``; one 
 Targets (issue 31): ``lcv roll`` <= 0.5 s with start-up; the roll measure set <= 3x the yaw-plane one;
 the native yaw-roll FMU's step <= 2x the yaw-plane one (the 6-unit vehicle's FMUs of both models
 in the plain C host of ``tests/c_host.c``, 10^6 steps of 1 ms with a residual force on the rear axle).
+Also the roll measures of a study batched over variants (the rear trailer's CG height and the
+trailers' roll stiffness scaled: each variant's yaw-roll coefficients built exactly) beside the loop
+of the one-variant calls (``measure_values``) on the same variants, with the largest difference.
 
     python benchmarks/roll.py
 """
@@ -90,11 +93,45 @@ def main() -> None:
     t_r, t_y = best(lambda: families(roll, v)), best(lambda: families(yaw, v))
     print(f"the roll families alone {t_r * 1e3:.1f} ms, the yaw-plane families but the turn {t_y * 1e3:.1f} ms: "
           f"ratio {t_r / t_y:.2f}")
+    batched_roll(v)
     plane, roll = native_step_rounds(v)
     ratios = sorted(r / p for p, r in zip(plane, roll))
     print(f"native FMU step in the C host, 6 units, {len(plane)} interleaved rounds: yaw-plane {min(plane):.3f} us, "
           f"yaw-roll {min(roll):.3f} us (best of each): ratio {min(roll) / min(plane):.2f}; median of the rounds' "
           f"ratios {ratios[len(ratios) // 2]:.2f} (target <= 2)")
+
+
+def batched_roll(vehicle, count: int = 128) -> None:
+    """The study's roll measures over ``count`` variants: batched against the loop of one-variant calls."""
+    import numpy as np
+
+    from lcvreport.analysis.batch import VariantBatch
+    from lcvreport.measures.measure_set import measure_values
+    from lcvreport.measures.registry import FAMILIES
+    from lcvreport.measures.roll import roll_batched, rollover_batched
+    rng = np.random.default_rng(7)
+    h, k = rng.uniform(0.9, 1.1, count), rng.uniform(0.8, 1.2, count)
+
+    def variant(i):
+        last = len(vehicle.units) - 1
+        return replace(vehicle, name=f"v{i}", units=tuple(replace(
+            u, cg_height_m=u.cg_height_m * (h[i] if j == last else 1.0), axles=tuple(replace(
+                a, roll_stiffness_Nm_per_rad=a.roll_stiffness_Nm_per_rad * (k[i] if j > 0 else 1.0)) for a in u.axles))
+            for j, u in enumerate(vehicle.units)))
+    keys = FAMILIES["roll"].batched_keys + FAMILIES["rollover"].batched_keys
+    t = time.perf_counter()
+    batch = VariantBatch.of_vehicles(vehicle, [variant(i) for i in range(count)], "yaw_roll")
+    got = np.column_stack(roll_batched(batch, SPEED_MPS) + rollover_batched(batch))
+    t_batch = time.perf_counter() - t
+    some = range(0, count, 8)
+    t = time.perf_counter()
+    ref = np.array([[measure_values(variant(i), SPEED_MPS, list(keys))[key] for key in keys] for i in some],
+                   dtype=float)
+    t_loop = (time.perf_counter() - t) / len(some) * count
+    diff = np.nanmax(np.abs(got[list(some)] - ref) / np.abs(ref))
+    print(f"roll measures ({', '.join(keys)}) of {count} variants, 6 units: batched {t_batch * 1e3 / count:.1f} ms "
+          f"per variant, the one-variant calls {t_loop * 1e3 / count:.1f} ms: ratio {t_batch / t_loop:.2f}; "
+          f"largest difference {diff:.1e} relative")
 
 
 def native_step_rounds(vehicle, rounds: int = 9) -> tuple[list, list]:

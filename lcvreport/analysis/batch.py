@@ -96,6 +96,8 @@ class VariantBatch:
     values: dict
     model: str = "yaw_plane"
     coefficients: dict = field(init=False, repr=False)
+    #: the variants as vehicles when the batch was built of them (:meth:`of_vehicles`)
+    variants: tuple | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self):
         lengths = {np.shape(v) for v in self.values.values()}
@@ -116,6 +118,50 @@ class VariantBatch:
                 coeffs[k] += (arr - p0).reshape((B,) + (1,) * d.ndim) * d
         self.coefficients = coeffs
 
+    @classmethod
+    def of_vehicles(cls, vehicle: Vehicle, variants, model: str = "yaw_plane", values: dict | None = None
+                    ) -> "VariantBatch":
+        """The variants given as vehicles, each one's coefficients built exactly (any parameter, also
+        one the model is not affine in: a CG height enters the yaw-roll model squared).  They must
+        share ``vehicle``'s geometry -- every map from the state to velocities, yaw rates and
+        positions, which the batch takes from ``vehicle`` -- else :class:`BatchError`.  ``values``:
+        the varied parameters, for the tables (optional)."""
+        variants = tuple(variants)
+        if not variants:
+            raise BatchError("a batch needs at least one variant")
+        base = linear_model(vehicle, model)
+        models = [linear_model(v, model) for v in variants]
+        maps = lambda m: (m.velocity_map(1.0), m.yaw_rate_map(), m.heading_rows(),  # noqa: E731
+                          m.roll_offset_rows() if m.roll_offset_rows() is not None else np.zeros(0))
+        ref = maps(base)
+        for k, m in enumerate(models):
+            if any(a.shape != b.shape or not np.array_equal(a, b) for a, b in zip(maps(m), ref)):
+                raise BatchError(f"variant {k} does not share the geometry of {vehicle.name} (the batch's maps "
+                                 "from the state to velocities and positions are the nominal vehicle's)")
+        batch = object.__new__(cls)
+        batch.vehicle, batch.model, batch.variants = vehicle, model, variants
+        batch.values = {} if values is None else {k: np.asarray(a) for k, a in values.items()}
+        batch.coefficients = {k: np.stack([getattr(m, k) for m in models]) for k in COEFFICIENTS}
+        return batch
+
+    def vehicles(self) -> tuple:
+        """The variants as vehicles (the nominal vehicle with each variant's values)."""
+        if self.variants is not None:
+            return self.variants
+        out = []
+        for b in range(self.size):
+            v = self.vehicle
+            for name, arr in self.values.items():
+                v = _with(v, name, float(np.asarray(arr)[b]))
+            out.append(v)
+        return tuple(out)
+
+    def on_model(self, model: str) -> "VariantBatch":
+        """The same variants on another linear model (their coefficients built exactly)."""
+        if model == self.model:
+            return self
+        return VariantBatch.of_vehicles(self.vehicle, self.vehicles(), model, self.values)
+
     @property
     def size(self) -> int:
         return self.coefficients["M0"].shape[0]
@@ -127,6 +173,7 @@ class VariantBatch:
         sub.model = self.model
         sub.values = {k: np.asarray(a)[rows] for k, a in self.values.items()}
         sub.coefficients = {k: a[rows] for k, a in self.coefficients.items()}
+        sub.variants = None if self.variants is None else tuple(np.asarray(self.variants, dtype=object)[rows])
         return sub
 
     def in_groups(self, fn, *args, group: int = 256):

@@ -226,19 +226,21 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
 
 def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0,
                         lane_change_ay_g: float | None = None,
-                        lane_change_frequency_hz: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+                        lane_change_frequency_hz: float | None = None, extra=None) -> tuple:
     """(HSTO [m], the lane change's RA [-]) of every variant, as
     :func:`lcvreport.measures.offtracking.lane_change_measures` (the path-following lane
-    change through each variant's inverse system): the last unit's rearmost axle's largest
-    overshoot beyond the steered axle's final offset (0 if none), and max|a_N| / max|a_s|.
-    NaN where the inverse system is unstable or does not exist, or the steer leaves
+    change through each variant's inverse system, on the batch's model): the last unit's rearmost
+    axle's largest overshoot beyond the steered axle's final offset (0 if none), and max|a_N| /
+    max|a_s|.  NaN where the inverse system is unstable or does not exist, or the steer leaves
     [-1, 1] rad (measure_set's null).  ``lane_change_ay_g`` [g] and ``lane_change_frequency_hz``
-    [Hz]: A0 and F (default :data:`LANE_CHANGE`)."""
+    [Hz]: A0 and F (default :data:`LANE_CHANGE`).  ``extra``: ``(X, XD, D)``, each variant's row of
+    one more signal ``y = X x + XD x' + D delta`` (shapes (B, n), (B, n), (B,)), whose peak |y| is
+    then returned third (the yaw-roll model's load transfer ratio)."""
     from ..analysis.exact import steered_point
     from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
-    from ..model.yaw_plane.outputs import point_lateral_map
     v = batch.vehicle
-    B, nu, n = batch.size, v.n_units, linear_model(v).n_states
+    co = linear_model(v, batch.model)
+    B, nu, n = batch.size, v.n_units, co.n_states
     accel_g = LANE_CHANGE[0] if lane_change_ay_g is None else float(lane_change_ay_g)
     f_hz = LANE_CHANGE[1] if lane_change_frequency_hz is None else float(lane_change_frequency_hz)
     steer = lane_change(accel_g * G_MPS2, f_hz)
@@ -247,38 +249,40 @@ def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
     sign = 1.0 if offset >= 0 else -1.0
     u = float(speed_mps)
     xs = steered_point(v)
-    rear = v.units[-1].rearmost_axle
-    cmap = point_lateral_map(v, nu - 1, rear.x_m)
-    cum = np.zeros((nu - 1, n + 2))
-    for k in range(nu - 1):
-        cum[k, nu + 1:nu + 2 + k] = 1.0
-    y_row = cmap[2:] @ cum if nu > 1 else np.zeros(n + 2)
-    y_row[n] += cmap[0]
-    y_row[n + 1] += cmap[1]
+    y_row = co.point_lateral_row(nu - 1, v.units[-1].rearmost_axle.x_m)     # Y of the rear axle over [x, psi1, Y1]
     ay_rows = batch.ay_rows(u, [nu - 1])
 
-    def signals(Mz, d_row, ctx):
-        C = np.zeros((Mz.shape[0], 4, Mz.shape[-1]))
-        C[:, 0, :n + 2] = y_row                                             # Y of the rear axle
-        C[:, 1] = ay_rows(Mz, d_row, ctx)[:, 0]                             # a_N
-        C[:, 2] = Mz[:, 0] + xs * Mz[:, 1]                                  # a_s = v1' + x_s r1' + u r1
-        C[:, 2, 1] += u
-        C[:, 3] = d_row                                                     # the steer (within [-1, 1] rad)
-        return C
-    hsto, ra = np.full(B, np.nan), np.full(B, np.nan)
+    def signals_of(rows):
+        def signals(Mz, d_row, ctx):
+            C = np.zeros((Mz.shape[0], 4 + (extra is not None), Mz.shape[-1]))
+            C[:, 0, :n + 2] = y_row                                         # Y of the rear axle
+            C[:, 1] = ay_rows(Mz, d_row, ctx)[:, 0]                         # a_N
+            C[:, 2] = Mz[:, 0] + xs * Mz[:, 1]                              # a_s = v1' + x_s r1' + u r1
+            C[:, 2, 1] += u
+            C[:, 3] = d_row                                                 # the steer (within [-1, 1] rad)
+            if extra is not None:                                           # X x + XD x' + D delta
+                X, XD, D = (np.asarray(a)[rows] for a in extra)
+                C[:, 4, :n] = X
+                C[:, 4] += np.einsum("bn,bnd->bd", XD, Mz[:, :n])
+                C[:, 4] += D[:, None] * d_row
+            return C
+        return signals
+    hsto, ra, peak_extra = np.full(B, np.nan), np.full(B, np.nan), np.full(B, np.nan)
     for g in range(0, B, RESPONSE_GROUP):
         rows = np.arange(g, min(B, g + RESPONSE_GROUP))
         ok = batch.inverse_stable(u, tire_scale, rows)
         rows = rows[ok]
         if not rows.size:
             continue
-        hi, lo = batch.extremes(u, steer, t_end, DT_S, signals, tire_scale, rows)
+        hi, lo = batch.extremes(u, steer, t_end, DT_S, signals_of(rows), tire_scale, rows)
         over = (hi[:, 0] - offset) if sign > 0 else -(lo[:, 0] - offset)
         peak = np.maximum(np.abs(hi), np.abs(lo))
         steer_ok = peak[:, 3] <= RANGES["steer_angle"].high                # else refused (measure_set's null)
         hsto[rows[steer_ok]] = np.maximum(0.0, over[steer_ok])
         ra[rows[steer_ok]] = peak[steer_ok, 1] / peak[steer_ok, 2]
-    return hsto, ra
+        if extra is not None:
+            peak_extra[rows[steer_ok]] = peak[steer_ok, 4]
+    return (hsto, ra) if extra is None else (hsto, ra, peak_extra)
 
 
 def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0,
@@ -290,7 +294,7 @@ def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
     u = float(speed_mps)
     omega = u / R
     v = batch.vehicle
-    x, delta = batch.steady(u, np.zeros(linear_model(v).n_states), omega, tire_scale)
+    x, delta = batch.steady(u, np.zeros(linear_model(v, batch.model).n_states), omega, tire_scale)
     beta = x @ linear_model(v, batch.model).velocity_map(u).T / u      # (B, N) CG sideslips
     d = chain_on_circle(v, beta, R)                                     # (B, N) the chain on the circle
     steered = max(v.steered_axles, key=lambda a: a.x_m)

@@ -146,6 +146,61 @@ def _dynamic(vehicle: Vehicle, u: float, s: float, f_hz: float = LANE_CHANGE[1],
     return values, reasons
 
 
+def roll_batched(batch, speed_mps: float, tire_scale: float = 1.0, f_hz: float = LANE_CHANGE[1],
+                 lane_change_ay_g: float = LANE_CHANGE[0], lane_change_frequency_hz: float = LANE_CHANGE[1]) -> tuple:
+    """The roll family's scalar measures over the variants of ``batch`` (any model: its variants
+    are taken to the yaw-roll model, each one's coefficients built exactly), one array each in the
+    registry's order: ``roll_least_damping_ratio``, ``roll_critical_speed_kph``,
+    ``ra_single_sine_roll``, ``ra_lane_change_roll``, ``hsto_m_roll``, ``rltr_lane_change`` -- the
+    numbers of :func:`roll_family` case by case (the batched least damping, critical speed, single
+    sine and lane change of the yaw plane, run on the yaw-roll model; the lane change also tracks
+    the rearmost group's load transfer ratio, each variant's own row).  NaN where undefined.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lcvreport import load_vehicle
+    >>> from lcvreport.analysis.batch import VariantBatch
+    >>> v = load_vehicle("examples/vehicles/b_double.toml")
+    >>> b = VariantBatch(v, {"rear_trailer.mass_kg": v.units[-1].mass_kg * np.array([0.9, 1.0])})
+    >>> zeta, crit, ra_ss, ra_lc, hsto, rltr = roll_batched(b, 25.0)
+    >>> bool(abs(rltr[1] - roll_summary(v, 25.0).ltr_lane_change[-1]) < 1e-12)
+    True
+    """
+    from .amplification import single_sine_batched
+    from .offtracking import lane_change_batched
+    from .stability import critical_speed_batched, least_damping_batched
+    if missing_roll_data(batch.vehicle) is not None:
+        return tuple(np.full(batch.size, np.nan) for _ in range(6))
+    rb = batch.on_model(MODEL)
+    u, s = float(speed_mps), float(tire_scale)
+    zeta = least_damping_batched(rb, u, s)[0]
+    crit = critical_speed_batched(rb, s)
+    nan = np.full(rb.size, np.nan)
+    if not rb.vehicle.steered_axles:
+        return zeta, crit, nan, nan, nan, nan.copy()
+    ra_ss = single_sine_batched(rb, u, f_hz, s)[0]
+    last = f"ltr{len(linear_model(rb.vehicle, MODEL).roll.groups)}"
+    rows = []
+    for v in rb.vehicles():                               # each variant's own load transfer row
+        names, X, XD, D, _O = linear_model(v, MODEL).extra_signals(u, s)
+        k = names.index(last)
+        rows.append((X[k], XD[k], D[k]))
+    extra = tuple(np.array([r[i] for r in rows]) for i in range(3))
+    hsto, ra_lc, rltr = lane_change_batched(rb, u, s, lane_change_ay_g, lane_change_frequency_hz, extra=extra)
+    return zeta, crit, ra_ss, ra_lc, hsto, rltr
+
+
+def rollover_batched(batch) -> tuple:
+    """``srt_rrcu_g`` and ``srt_min_g`` [g] of every variant of ``batch`` (:func:`rollover_family`
+    variant by variant: the threshold's events are exact, one short search per variant); NaN
+    without roll data."""
+    if missing_roll_data(batch.vehicle) is not None:
+        return np.full(batch.size, np.nan), np.full(batch.size, np.nan)
+    out = np.array([[t.srt_rrcu_g, t.srt_min_g] for t in map(rollover_threshold, batch.vehicles())], dtype=float)
+    return out[:, 0], out[:, 1]
+
+
 def _no_roll(keys, vehicle: Vehicle):
     why = missing_roll_data(vehicle)
     if why is None:

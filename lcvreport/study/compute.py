@@ -1,5 +1,6 @@
 """The measures of a chunk of a study's cases: batched over the cases where the measure has a
-batched form (:mod:`lcvreport.analysis.batch`), case by case with :func:`measure_set` otherwise.
+batched form (:mod:`lcvreport.analysis.batch`; the roll measures on a batch of the cases' own
+vehicles, their yaw-roll coefficients built exactly), case by case with :func:`measure_set` otherwise.
 
 The cases of a chunk are grouped by speed and tire scale (the batch runs at one of each); a
 group is one :class:`~lcvreport.analysis.batch.VariantBatch`.  Undefined measures are NaN (the
@@ -25,6 +26,7 @@ from ..measures.measure_set import measure_values
 from ..measures.registry import BATCHED as BATCH_GROUPS
 from ..measures.registry import FAMILIES, MeasureCase
 from ..model.linear import linear_model
+from ..model.yaw_roll.parameters import missing_roll_data
 from .spec import BATCHED, ROLL_PARAMETERS, Study
 
 
@@ -42,6 +44,8 @@ def compute_chunk(study: Study, case_ids) -> dict:
         cols[m] = np.full(ids.size, np.nan)
     v = study.vehicle
     batched = set(study.measures) & set(BATCHED) if v.steered_axles else set()
+    if missing_roll_data(v) is not None:          # null case by case, with the missing key named
+        batched -= {k for g, keys in BATCH_GROUPS.items() if FAMILIES[g].model == "yaw_roll" for k in keys}
     groups = [g for g, keys in BATCH_GROUPS.items() if batched & set(keys)]
     F = None
     if "trim" in groups:
@@ -55,10 +59,14 @@ def compute_chunk(study: Study, case_ids) -> dict:
             rows = np.flatnonzero(inverse.ravel() == g)
             values = {k: arr[rows] for k, arr in params.items()        # the yaw plane reads no roll key
                       if k.split(".", 1)[1] not in ROLL_PARAMETERS}
-            batch = VariantBatch(v, values)
+            batches = {"yaw_plane": VariantBatch(v, values)}
             for group in groups:
+                model = FAMILIES[group].model
+                if model not in batches:              # every case's own vehicle, its coefficients exact
+                    batches[model] = VariantBatch.of_vehicles(
+                        v, [study.case_vehicle(params, int(k)) for k in rows], model)
                 case = MeasureCase(v, float(u), float(ts), RA_FREQUENCY_HZ, None if F is None else F[rows])
-                arrays = FAMILIES[group].compute_batched(batch, case)
+                arrays = FAMILIES[group].compute_batched(batches[model], case)
                 for name, arr in zip(BATCH_GROUPS[group], arrays):
                     if name in batched:
                         cols[name][rows] = np.broadcast_to(arr, rows.shape)

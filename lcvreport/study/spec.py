@@ -50,19 +50,24 @@ import numpy as np
 
 from ..measures.registry import BATCHED as _BATCH_GROUPS
 from ..measures.registry import CRITERIA_KEYS, unknown_key_message
+from ..measures.registry import FAMILIES as _FAMILIES
 from ..model.vehicle import Vehicle, VehicleError
 from ..model.vehicle_file import dumps_vehicle, load_vehicle, loads_vehicle
 from ..ranges import RANGES, RangeError
 from ..units import kph_to_mps
 
 #: measures computed batched over the cases (lcvreport.analysis.batch, the registry's BATCHED groups);
-#: the others of the registry are computed case by case with measure_set (same numbers, slower)
+#: (the roll measures on the cases' own vehicles); the others of the registry are computed case by
+#: case with measure_set (same numbers, slower)
 BATCHED = tuple(k for keys in _BATCH_GROUPS.values() for k in keys)
 #: every measure a study can ask for: the scalar keys of the measure registry
 MEASURES = tuple(CRITERIA_KEYS)
 #: the trim's measures: need a residual source (a load case or a residual-source factor)
 TRIM = _BATCH_GROUPS["trim"]
-DEFAULT_MEASURES = tuple(k for k in BATCHED if k not in TRIM and k != "yaw_damping_lower_bound")
+#: a study's measures when it names none: the yaw-plane ones computed batched (the roll measures,
+#: batched too, are asked for by name: they need the roll keys)
+DEFAULT_MEASURES = tuple(k for g, keys in _BATCH_GROUPS.items() if _FAMILIES[g].model == "yaw_plane" for k in keys
+                         if k not in TRIM and k != "yaw_damping_lower_bound")
 UNIT_SCALES = {"mass_scale": "mass_kg", "yaw_inertia_scale": "yaw_inertia_kg_m2",
                # roll (docs/roll.md): on a vehicle with the roll keys
                "cg_height_scale": "cg_height_m", "roll_inertia_scale": "roll_inertia_kg_m2",
@@ -342,25 +347,28 @@ class Study:
         """(vehicle, speed_mps, kwargs) of one case: ``measure_set(vehicle, speed_mps, **kwargs)``
         computes its row."""
         table = self.factor_table([case_id])
-        v = self.vehicle
-        units = list(v.units)
-        for pname, arr in self.batch_parameters(table).items():
-            owner, key = pname.split(".", 1)
-            for i, u in enumerate(units):
-                if u.name == owner:
-                    units[i] = replace(u, **{key: float(arr[0])})
-                for j, a in enumerate(u.axles):
-                    if a.name == owner:
-                        axles = list(units[i].axles)
-                        axles[j] = replace(axles[j], **{key: float(arr[0])})
-                        units[i] = replace(units[i], axles=tuple(axles))
         kwargs = {"tire_scale": float(table["tire_scale"][0])} if "tire_scale" in table else {}
         if "load_units" in table and table["load_units"][0] != "none":
             kwargs["load_units"] = table["load_units"][0].split("+")
         sources = self.sources({k: a[:1] for k, a in table.items()}, 0)
         if sources:
             kwargs["sources"] = sources
-        return replace(v, units=tuple(units)), float(self.speeds_mps(table)[0]), kwargs
+        return self.case_vehicle(self.batch_parameters(table), 0), float(self.speeds_mps(table)[0]), kwargs
+
+    def case_vehicle(self, params: dict, k: int) -> Vehicle:
+        """The vehicle of row ``k`` of the scaled parameters ``params`` (:meth:`batch_parameters`)."""
+        units = list(self.vehicle.units)
+        for pname, arr in params.items():
+            owner, key = pname.split(".", 1)
+            for i, u in enumerate(units):
+                if u.name == owner:
+                    units[i] = replace(u, **{key: float(arr[k])})
+                for j, a in enumerate(u.axles):
+                    if a.name == owner:
+                        axles = list(units[i].axles)
+                        axles[j] = replace(axles[j], **{key: float(arr[k])})
+                        units[i] = replace(units[i], axles=tuple(axles))
+        return replace(self.vehicle, units=tuple(units))
 
     def sources(self, table: dict, k: int):
         """The residual sources (docs/manoeuvres.md) of row ``k`` of ``table``: a
