@@ -99,6 +99,10 @@ def main() -> None:
     print(f"native FMU step in the C host, 6 units, {len(plane)} interleaved rounds: yaw-plane {min(plane):.3f} us, "
           f"yaw-roll {min(roll):.3f} us (best of each): ratio {min(roll) / min(plane):.2f}; median of the rounds' "
           f"ratios {ratios[len(ratios) // 2]:.2f} (target <= 2)")
+    plane_i, roll_i = native_step_instructions(v)
+    print(f"native FMU step, instructions counted by callgrind (deterministic: the same counts on a loaded "
+          f"machine): yaw-plane {plane_i:.0f}, yaw-roll {roll_i:.0f} per step: ratio {roll_i / plane_i:.2f} "
+          "(target <= 2)")
 
 
 def batched_roll(vehicle, count: int = 128) -> None:
@@ -145,6 +149,36 @@ def native_step_rounds(vehicle, rounds: int = 9) -> tuple[list, list]:
                  f"P_{vehicle.axles[-1].name}", "Y_rear") for model in ("yaw_plane", "yaw_roll")]
         plane, roll = c_host_rounds(fmus, rounds)
     return plane, roll
+
+def native_step_instructions(vehicle, steps: tuple[int, int] = (10_000, 30_000)) -> tuple[float, float]:
+    """Instructions per step of the vehicle's native FMUs of both models in tests/c_host.c, counted
+    by valgrind's callgrind (the difference of two runs of ``steps`` steps: start-up cancels)."""
+    import re
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    from lcvreport.fmu.build import build_vehicle_fmus
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        exe = Path(tmp) / "c_host"
+        subprocess.run(["gcc", "-O2", "-std=c99", "-o", str(exe), str(ROOT / "tests" / "c_host.c"), "-ldl"],
+                       check=True)
+        for model in ("yaw_plane", "yaw_roll"):
+            fmu = build_vehicle_fmus(vehicle, Path(tmp) / model, kind="native", model=model)[0]
+            unzipped = Path(tmp) / model / "x"
+            zipfile.ZipFile(fmu).extractall(unzipped)
+            root = ET.parse(unzipped / "modelDescription.xml").getroot()
+            vr = {sv.get("name"): sv.get("valueReference") for sv in root.iter("ScalarVariable")}
+            counts = []
+            for n in steps:
+                p = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={tmp}/cg.out", str(exe),
+                                    str(unzipped), f"{vehicle.name}Native", root.get("guid"), "bench", str(n), "0.001",
+                                    vr[f"P_{vehicle.axles[-1].name}"], vr["Y_rear"]], capture_output=True, text=True,
+                                   check=True)
+                counts.append(int(re.search(r"Collected : (\d+)", p.stderr).group(1)))
+            out.append((counts[1] - counts[0]) / (steps[1] - steps[0]))
+    return out[0], out[1]
+
 
 if __name__ == "__main__":
     main()

@@ -168,13 +168,12 @@ def held_response(vehicle: Vehicle, time: np.ndarray, Z: np.ndarray, speed_mps: 
     K = t.size
     h = np.diff(t)
     # pieces: maximal runs of samples with the same speed, force, steer and step (to rounding)
-    starts = [0]
-    for i in range(1, K):
-        same = (u[i] == u[i - 1] and np.array_equal(f[i], f[i - 1]) and (d is None or d[i] == d[i - 1])
-                and (i == K - 1 or abs(h[i] - h[i - 1]) <= 1e-9 * h[i - 1]))
-        if not same:
-            starts.append(i)
-    starts.append(K)
+    new = (u[1:] != u[:-1]) | np.any(f[1:] != f[:-1], axis=1)
+    if d is not None:
+        new |= d[1:] != d[:-1]
+    if K > 2:
+        new[:-1] |= np.abs(h[1:] - h[:-1]) > 1e-9 * h[:-1]           # the last sample has no step of its own
+    starts = [0, *(np.flatnonzero(new) + 1).tolist(), K]
     maps = {}
     segments = []
     Zaug = np.column_stack([Z, np.ones(K)])
