@@ -307,34 +307,6 @@ static fmi3Status no_variables(fmi3Instance instance, size_t nvr, const char *fu
 
 #include "fmi3_no_variables.h"     /* fmi3Get/Set of the types this FMU has no variables of */
 
-fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
-                         size_t valueSizes[], fmi3Binary values[], size_t nValues)
-{
-    (void)valueReferences; (void)valueSizes; (void)values; (void)nValues;
-    return no_variables(instance, nValueReferences, "fmi3GetBinary", "Binary");
-}
-
-fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
-                         const size_t valueSizes[], const fmi3Binary values[], size_t nValues)
-{
-    (void)valueReferences; (void)valueSizes; (void)values; (void)nValues;
-    return no_variables(instance, nValueReferences, "fmi3SetBinary", "Binary");
-}
-
-fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
-                        fmi3Clock values[])
-{
-    (void)valueReferences; (void)values;
-    return no_variables(instance, nValueReferences, "fmi3GetClock", "Clock");
-}
-
-fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
-                        const fmi3Clock values[])
-{
-    (void)valueReferences; (void)values;
-    return no_variables(instance, nValueReferences, "fmi3SetClock", "Clock");
-}
-
 static fmi3Status not_provided(fmi3Instance instance, const char *what)
 {
     Instance3 *c = (Instance3 *)instance;

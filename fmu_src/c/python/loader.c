@@ -61,26 +61,7 @@
     X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize) X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate) \
     X(fmi2DoStep) X(fmi2GetRealStatus)
 
-#define DECLARE(F) static F##TYPE *p_##F;
-FORWARDED(DECLARE)
-#undef DECLARE
-
-/* the Python runtime (pyruntime.c) and pythonfmu's functions, once per process; NULL or the reason */
-static pthread_once_t resolved_once = PTHREAD_ONCE_INIT;
-static const char *load_error = NULL;
-static char resolve_error[2400];
-
-static void resolve(void)
-{
-    const char *path = NULL;
-    void *lib = pyrt_start(&load_error, &path);
-    if (!lib) return;
-#define RESOLVE(F) \
-    if (!(p_##F = (F##TYPE *)dlsym(lib, #F))) { \
-        snprintf(resolve_error, sizeof resolve_error, "%.1800s lacks %s", path, #F); load_error = resolve_error; return; }
-    FORWARDED(RESOLVE)
-#undef RESOLVE
-}
+#include "loader_forward.inc"         /* p_<F>, resolve(): the Python runtime and the library, once */
 
 /* phases: the C FMU's (fmu_common.h), with the same masks as fmi2_api.c */
 #define MASK_fmi2SetupExperiment PhaseInstantiated

@@ -39,25 +39,7 @@
     X(fmi3SetFMUState) X(fmi3FreeFMUState) X(fmi3SerializedFMUStateSize) X(fmi3SerializeFMUState) \
     X(fmi3DeserializeFMUState)
 
-#define DECLARE(F) static F##TYPE *p_##F;
-FORWARDED(DECLARE)
-#undef DECLARE
-
-static pthread_once_t resolved_once = PTHREAD_ONCE_INIT;
-static const char *load_error = NULL;
-static char resolve_error[2400];
-
-static void resolve(void)
-{
-    const char *path = NULL;
-    void *lib = pyrt_start(&load_error, &path);
-    if (!lib) return;
-#define RESOLVE(F) \
-    if (!(p_##F = (F##TYPE *)dlsym(lib, #F))) { \
-        snprintf(resolve_error, sizeof resolve_error, "%.1800s lacks %s", path, #F); load_error = resolve_error; return; }
-    FORWARDED(RESOLVE)
-#undef RESOLVE
-}
+#include "loader_forward.inc"         /* p_<F>, resolve(): the Python runtime and the library, once */
 
 /* phases (fmu_common.h): Co-Simulation without event mode */
 #define PhaseStepMode PhaseStepComplete
@@ -468,34 +450,6 @@ static fmi3Status no_variables(fmi3Instance instance, size_t nvr, const char *fu
 }
 
 #include "fmi3_no_variables.h"     /* fmi3Get/Set of the types this FMU has no variables of */
-
-fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
-                         size_t valueSizes[], fmi3Binary values[], size_t nValues)
-{
-    (void)valueReferences; (void)valueSizes; (void)values; (void)nValues;
-    return no_variables(instance, nValueReferences, "fmi3GetBinary", "Binary");
-}
-
-fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
-                         const size_t valueSizes[], const fmi3Binary values[], size_t nValues)
-{
-    (void)valueReferences; (void)valueSizes; (void)values; (void)nValues;
-    return no_variables(instance, nValueReferences, "fmi3SetBinary", "Binary");
-}
-
-fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
-                        fmi3Clock values[])
-{
-    (void)valueReferences; (void)values;
-    return no_variables(instance, nValueReferences, "fmi3GetClock", "Clock");
-}
-
-fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
-                        const fmi3Clock values[])
-{
-    (void)valueReferences; (void)values;
-    return no_variables(instance, nValueReferences, "fmi3SetClock", "Clock");
-}
 
 /* ------------------------------------------------------------------ what a Co-Simulation FMU without events lacks */
 static fmi3Status unsupported(fmi3Instance instance, const char *function, const char *why)
