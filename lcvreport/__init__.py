@@ -1,4 +1,4 @@
-"""lcvreport: linear yaw-plane dynamics of long combination vehicles.
+"""lcvreport: linear yaw-plane and yaw-roll dynamics of long combination vehicles.
 
 A tractor or truck pulling any chain of trailers, dollies and full trailers, in the
 thesis form ``M x' = S x + F`` (J. J. Patterson, "Effect of conicity and ply steer on
