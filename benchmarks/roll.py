@@ -123,14 +123,16 @@ def batched_roll(vehicle, count: int = 128) -> None:
                 a, roll_stiffness_Nm_per_rad=a.roll_stiffness_Nm_per_rad * (k[i] if j > 0 else 1.0)) for a in u.axles))
             for j, u in enumerate(vehicle.units)))
     keys = FAMILIES["roll"].batched_keys + FAMILIES["rollover"].batched_keys
+    warm = VariantBatch.of_vehicles(vehicle, [variant(0)], "yaw_roll")        # both paths' first-use costs out
+    roll_batched(warm, SPEED_MPS), rollover_batched(warm), measure_values(variant(0), SPEED_MPS, list(keys))
     t = time.perf_counter()
     batch = VariantBatch.of_vehicles(vehicle, [variant(i) for i in range(count)], "yaw_roll")
     got = np.column_stack(roll_batched(batch, SPEED_MPS) + rollover_batched(batch))
     t_batch = time.perf_counter() - t
     some = range(0, count, 8)
     t = time.perf_counter()
-    ref = np.array([[measure_values(variant(i), SPEED_MPS, list(keys))[key] for key in keys] for i in some],
-                   dtype=float)
+    ref = np.array([[row[key] for key in keys] for row in (measure_values(variant(i), SPEED_MPS, list(keys))
+                                                           for i in some)], dtype=float)
     t_loop = (time.perf_counter() - t) / len(some) * count
     diff = np.nanmax(np.abs(got[list(some)] - ref) / np.abs(ref))
     print(f"roll measures ({', '.join(keys)}) of {count} variants, 6 units: batched {t_batch * 1e3 / count:.1f} ms "
