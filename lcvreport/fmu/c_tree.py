@@ -27,9 +27,9 @@ NATIVE_HEADERS = ("api/fmu_common.h", "api/model_api.h", "vehicle/model.h", "veh
 LOADER_INCLUDE_DIRS = ("api", "python")
 LOADER_SOURCES = {2: ("python/loader.c", "python/pyruntime.c", "api/fmu_common.c"),
                   3: ("python/loader3.c", "python/pyruntime.c", "api/fmu_common.c")}
-LOADER_HEADERS = {2: ("python/pyruntime.h", "python/loader_forward.inc", "python/loader_state.inc", "api/fmu_common.h"),
-                  3: ("python/pyruntime.h", "python/loader_forward.inc", "python/loader_state.inc", "api/fmu_common.h",
-                      "api/fmi3_no_variables.h")}
+_LOADER_SHARED = ("python/pyruntime.h", "python/loader_forward.inc", "python/loader_guard.inc",
+                  "python/loader_state.inc", "api/fmu_common.h")
+LOADER_HEADERS = {2: _LOADER_SHARED, 3: _LOADER_SHARED + ("api/fmi3_no_variables.h",)}
 #: the driver FMU (FMI 2): the driver model behind the same API file as the vehicle's
 DRIVER_INCLUDE_DIRS = ("api", "driver")
 DRIVER_SOURCES = ("api/fmi2_api.c", "api/fmu_common.c", "driver/driver.c")

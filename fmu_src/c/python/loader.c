@@ -161,6 +161,15 @@ static int resource_folder(const char *uri, char *out, size_t size, char *why, s
     return 1;
 }
 
+/* the FMI 2 statuses, for the code both loaders share (loader_guard.inc, loader_state.inc) */
+#define LS_STATUS fmi2Status
+#define LS_OK fmi2OK
+#define LS_WARNING fmi2Warning
+#define LS_DISCARD fmi2Discard
+#define LS_ERROR fmi2Error
+#define LS_FATAL fmi2Fatal
+#define LS_FREE_INSTANCE "fmi2FreeInstance"
+
 /* ------------------------------------------------------------------ logging */
 static void host_log(Wrapper *w, fmi2Status status, const char *category, const char *text)
 {
@@ -207,35 +216,7 @@ static void say_once(const fmi2CallbackFunctions *functions, const char *name, c
     functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError", esc);
 }
 
-/* the status to report: pythonfmu's, made fmi2Error when the call logged an error */
-static fmi2Status outcome(Wrapper *w, fmi2Status s, const char *function)
-{
-    if (s == fmi2Fatal) {
-        w->dead = 1;
-        w->phase = PhaseError;
-        say(w, fmi2Error, "%s: the Python model failed; this instance cannot be used any more "
-                          "(fmi2FreeInstance it)", function);
-        return fmi2Error;
-    }
-    if (w->worst >= fmi2Error || s == fmi2Error || s == fmi2Discard) return fmi2Error;
-    if (s == fmi2OK && w->worst == fmi2Warning) return fmi2Warning;
-    return s;
-}
-
-static int usable(Wrapper *w, const char *function, int mask)
-{
-    if (!w) return 0;
-    if (w->dead) {
-        say(w, fmi2Error, "%s: this instance failed before and cannot be used any more", function);
-        return 0;
-    }
-    if (!(w->phase & mask)) {
-        say(w, fmi2Error, "%s must not be called in phase %s", function, phase_name(w->phase));
-        return 0;
-    }
-    w->worst = fmi2OK;
-    return 1;
-}
+#include "loader_guard.inc"           /* outcome(), usable() */
 
 #define USABLE(F) usable(w, #F, MASK_##F)
 
@@ -456,11 +437,7 @@ NO_VARIABLES(fmi2SetBoolean, "Boolean", const fmi2Boolean)
 /* ------------------------------------------------------------------ FMU state */
 /* pythonfmu's state of the slave and the phase (loader_state.inc, shared with loader3.c) */
 #define LS_STATE fmi2FMUstate
-#define LS_STATUS fmi2Status
 #define LS_BYTE fmi2Byte
-#define LS_OK fmi2OK
-#define LS_WARNING fmi2Warning
-#define LS_ERROR fmi2Error
 #define LS_TAG 0x4C435653U                /* "LCVS" */
 #define LS_KEEPS_TIME 0
 #define LS_GET p_fmi2GetFMUstate

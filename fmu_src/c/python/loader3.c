@@ -59,6 +59,15 @@ typedef struct {
     char *alias;                          /* a symlink to it pythonfmu3 reads as is, or NULL (pyruntime.h) */
 } Wrapper;
 
+/* the FMI 3 statuses, for the code both loaders share (loader_guard.inc, loader_state.inc) */
+#define LS_STATUS fmi3Status
+#define LS_OK fmi3OK
+#define LS_WARNING fmi3Warning
+#define LS_DISCARD fmi3Discard
+#define LS_ERROR fmi3Error
+#define LS_FATAL fmi3Fatal
+#define LS_FREE_INSTANCE "fmi3FreeInstance"
+
 /* ------------------------------------------------------------------ logging */
 static void say(Wrapper *w, fmi3Status status, const char *fmt, ...)
 {
@@ -81,35 +90,7 @@ static void own_logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3Strin
                 message ? message : "");
 }
 
-/* the status to report: pythonfmu3's, made fmi3Error when the call logged an error */
-static fmi3Status outcome(Wrapper *w, fmi3Status s, const char *function)
-{
-    if (s == fmi3Fatal) {
-        w->dead = 1;
-        w->phase = PhaseError;
-        say(w, fmi3Error, "%s: the Python model failed; this instance cannot be used any more (fmi3FreeInstance it)",
-            function);
-        return fmi3Error;
-    }
-    if (w->worst >= fmi3Error || s == fmi3Error || s == fmi3Discard) return fmi3Error;
-    if (s == fmi3OK && w->worst == fmi3Warning) return fmi3Warning;
-    return s;
-}
-
-static int usable(Wrapper *w, const char *function, int mask)
-{
-    if (!w) return 0;
-    if (w->dead) {
-        say(w, fmi3Error, "%s: this instance failed before and cannot be used any more", function);
-        return 0;
-    }
-    if (!(w->phase & mask)) {
-        say(w, fmi3Error, "%s must not be called in phase %s", function, phase_name(w->phase));
-        return 0;
-    }
-    w->worst = fmi3OK;
-    return 1;
-}
+#include "loader_guard.inc"           /* outcome(), usable() */
 
 #define BEGIN(F, MASK) \
     Wrapper *w = (Wrapper *)instance; \
@@ -660,11 +641,7 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueRefere
 /* ------------------------------------------------------------------ FMU state */
 /* pythonfmu3's state of the slave, the phase and the time (loader_state.inc, shared with loader.c) */
 #define LS_STATE fmi3FMUState
-#define LS_STATUS fmi3Status
 #define LS_BYTE fmi3Byte
-#define LS_OK fmi3OK
-#define LS_WARNING fmi3Warning
-#define LS_ERROR fmi3Error
 #define LS_TAG 0x4C435633U                /* "LCV3" */
 #define LS_KEEPS_TIME 1
 #define LS_GET p_fmi3GetFMUState
