@@ -16,9 +16,10 @@ export SOURCE_DATE_EPOCH=1312156800   # 2011-08-01, the dissertation's date: rep
 
 # Debian packages: LaTeX route of nbconvert (PDF), MathJax for the offline HTML,
 # TBB for ecos, poppler for PDF checks, valgrind and gcc for the native FMU, cmake and make
-# for `fmpy compile` (a test rebuilds the native FMU from its sources/).
+# for `fmpy compile` (a test rebuilds the native FMU from its sources/), Chromium for the browser
+# tests (tests/browser/: Playwright drives Debian's chromium; its own browser download is not used).
 APT_PACKAGES=(texlive-xetex texlive-latex-recommended texlive-fonts-recommended texlive-plain-generic pandoc libjs-mathjax
-              fonts-dejavu-core libtbb12 poppler-utils valgrind gcc cmake make)
+              fonts-dejavu-core libtbb12 poppler-utils valgrind gcc cmake make chromium)
 
 log() { printf '[build.sh] %s\n' "$*" >&2; }
 

@@ -14,11 +14,13 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``numerics``         numpy-only numerics: equilibrated solve, expm
     ``threads``          one BLAS thread at the entry points (LCV_BLAS_THREADS to change it)
     ``files``            the one guarded reader of every file a user hands in (regular files, a size limit, UTF-8)
+    ``text``             what a user's text may hold (no control characters) and how a message quotes it
 ``model/``               **what a vehicle is, and the models of it** (numpy only):
     ``vehicle``          Axle, Unit, Vehicle (SI parameter sets, validated)
     ``vehicle_file``     vehicle files (TOML, SI): load_vehicle, dumps_vehicle
     ``presets``          the six thesis vehicles, shipped as vehicle files
     ``plausibility``     warnings for legal but implausible numbers (unit typos)
+    ``statics``          static axle and coupling loads that follow the masses (mass factors, payloads)
     ``body``             the body of every unit: kind, extent, corners, overall length, poses
     ``linear``           the model seam: LinearModel (what analysis needs of any linear model), MODELS
     ``yaw_plane/``       the linear yaw-plane model of the thesis, ``M x' = S x + F``:
@@ -104,6 +106,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
                          repository's ``fmu_src/``, installed as ``lcvreport.fmu_src``)
 ``study/``               **studies at scale** (pandas, pyarrow, dask on use):
     ``spec``             the study file: vehicle, factors, design, measures; the cases
+    ``factors``          a study's factors: scales, payloads, load cases, residual sources, their checks
     ``compute``          the measures of a chunk of cases, batched over the cases
     ``folder``           the study folder's files and chunk names
     ``run``              ``lcv study``: chunks on Dask, Parquet written atomically, resume

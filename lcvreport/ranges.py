@@ -134,7 +134,7 @@ class Range:
             raise RangeError(name, f"{name} must be a number in {self.text(factor, unit)}, got {value!r}")
         v = float(value)
         if not (math.isfinite(v) and self.contains(v / factor)):
-            raise RangeError(name, f"{name} must be in {self.text(factor, unit)}, got {v:.6g}")
+            raise RangeError(name, f"{name} must be in {self.text(factor, unit)}, got {given(v)}")
         return v
 
 
@@ -169,6 +169,7 @@ RANGES: dict[str, Range] = dict([
                           description="radius of the outside steer wheel's path in the low-speed turn")),
     ("turn_angle", Range("turn angle", "deg", 0.0, 3600.0, low_open=True,
                          description="angle of the low-speed turn (ten laps at most)")),
+    ("payload", Range("payload", "kg", 0.0, 1e5, description="a payload added to one unit in a study")),
 ])
 
 #: vehicle-file limits (SI, per tire where the file is per tire)
@@ -218,6 +219,19 @@ VEHICLE: dict[str, Range] = {
 GYRATION_PER_REACH_MIN = 1e-3
 
 
+def given(value: float) -> str:
+    """A refused number as the message prints it: as given, to every digit that tells it from the
+    limit (20.000001 is not "20"), compact when it is long.
+
+    Examples
+    --------
+    >>> given(20.000001), given(1e300), given(250.0), given(-0.0501)
+    ('20.000001', '1e+300', '250', '-0.0501')
+    """
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
+
+
 def check(key: str, value, name: str | None = None, factor: float = 1.0, unit: str | None = None) -> float:
     """Check ``value`` against ``RANGES[key]``; see :meth:`Range.check`."""
     return RANGES[key].check(value, name, factor, unit)
@@ -233,7 +247,7 @@ def check_array(key: str, values, name: str | None = None):
     if not np.all(ok):
         bad = flat[~ok][0]
         name = name or r.name
-        raise RangeError(name, f"{name} must be in {r.text()}, got {bad:.6g}")
+        raise RangeError(name, f"{name} must be in {r.text()}, got {given(bad)}")
     return arr
 
 

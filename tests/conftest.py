@@ -35,6 +35,60 @@ EXAMPLE_NAMES = ("western_double", "b_double", "truck_full_trailer")
 collect_ignore = ["data", "hostile_driver.py"]
 
 
+# ---------------------------------------------------------------------------- reports built once
+# Session fixtures (a module fixture is torn down and built again whenever xdist interleaves
+# another module's test); every test using one carries the fixture's xdist group, so that a run
+# under --dist loadgroup builds each report once.
+def build_thesis_report(build_dir: Path, *extra: str) -> subprocess.CompletedProcess:
+    """``python -m lcvreport.report.build --fast`` into ``build_dir``."""
+    return subprocess.run([sys.executable, "-m", "lcvreport.report.build", "--build-dir", str(build_dir), "--fast",
+                           *extra], capture_output=True, text=True, cwd=ROOT, timeout=900)
+
+
+@pytest.fixture(scope="session")
+def thesis_report(tmp_path_factory):
+    """The thesis report (fast, with its PDF): xdist group ``thesis_report``."""
+    d = tmp_path_factory.mktemp("report1")
+    p = build_thesis_report(d)
+    assert p.returncode == 0, p.stderr[-4000:]
+    return d
+
+
+TRACKING_STATS = "conicity=normal:0:120,ply_steer=normal:40:60,mounting=random,draws=200000,seed=7"
+MOUNTED = EXAMPLES.parent / "tires" / "aucnat_rear_trailers_mounted.csv"
+#: the vehicle reports (lcv report): an example file, and a preset with loads and the tracking chapter
+ASSESSMENTS = {"western_double": ["--vehicle", str(EXAMPLES / "western_double.toml")],
+               "aucnat": ["--preset", "aucnat", "--load", "trailer2,trailer3", "--tires", str(MOUNTED),
+                          "--tracking-stats", TRACKING_STATS]}
+
+
+@pytest.fixture(scope="session", params=sorted(ASSESSMENTS))
+def assessment(request, tmp_path_factory):
+    """(name, folder, completed process) of ``lcv report`` of :data:`ASSESSMENTS`: xdist group ``assessment``."""
+    out = tmp_path_factory.mktemp(f"assess_{request.param}")
+    p = subprocess.run([sys.executable, "-m", "lcvreport.cli", "report", *ASSESSMENTS[request.param], "--speed-kph",
+                        "88", "--out", str(out)], capture_output=True, text=True, timeout=600, cwd=out.parent)
+    assert p.returncode == 0, (p.stdout + p.stderr)[-4000:]
+    return request.param, out, p
+
+
+SCHEME_TEMPLATE = ROOT / "examples" / "schemes" / "template.toml"
+
+
+@pytest.fixture(scope="session")
+def scheme_report(tmp_path_factory):
+    """(folder, vehicle file, --json document) of ``lcv assess --out`` of the b-double against the
+    template scheme: xdist group ``scheme_report``."""
+    import json
+    out = tmp_path_factory.mktemp("assess") / "report"
+    vehicle = EXAMPLES / "b_double.toml"
+    p = subprocess.run([sys.executable, "-m", "lcvreport.cli", "assess", "--vehicle", str(vehicle), "--scheme",
+                        str(SCHEME_TEMPLATE), "--out", str(out), "--json"], capture_output=True, text=True,
+                       timeout=600)
+    assert p.returncode == 0, p.stderr
+    return out, vehicle, json.loads(p.stdout)
+
+
 @pytest.fixture(scope="session")
 def aucnat():
     return load_preset("aucnat")

@@ -96,7 +96,8 @@ levels = { A = { max = "2 * srt_rrcu_g" }, B = { max = "8 * srt_rrcu_g" } }
 OPTION = {"speed_kph": "--speed-kph", "ra_frequency_hz": "--ra-frequency-hz", "lane_change_ay_g": "--lane-change-ay-g",
           "lane_change_frequency_hz": "--lane-change-frequency-hz", "steady_turn_radius_m": "--steady-turn-radius-m",
           "turn_radius_m": "--turn-radius-m", "turn_angle_deg": "--turn-angle-deg",
-          "crossfall_percent": "--crossfall-percent"}
+          "crossfall_percent": "--crossfall-percent", "ra_numerator": "--ra-numerator",
+          "ra_denominator": "--ra-denominator"}
 
 
 def _run(args, **kw):
@@ -118,7 +119,7 @@ def test_a_hidden_scheme_gives_the_numbers_of_lcv_measures_one_by_one(tmp_path, 
         cond = m["conditions"]
         args = ["measures", "--vehicle", vehicle, "--json"]
         for k, v in cond.items():
-            args += [OPTION[k], repr(v)]
+            args += [OPTION[k], v if isinstance(v, str) else repr(v)]
         if "speed_kph" not in cond:
             args += ["--speed-kph", "88"]                     # a measure the speed plays no part in
         key = tuple(args)

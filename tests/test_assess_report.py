@@ -1,79 +1,34 @@
 """The assessment report of ``lcv assess --out`` (docs/assessment.md#report): its first page is
 the verdict table, it names the toolkit's version and both files' SHA-256, and the folder is
-self-contained -- copied to another path it keeps its mathematics (MathJax copied, not linked)."""
+self-contained (MathJax copied, not linked: tests/browser/ renders a copy elsewhere)."""
 from __future__ import annotations
 
 import hashlib
-import json
-import re
-import shutil
 import subprocess
 import sys
 from importlib.metadata import version
 from pathlib import Path
 
-import nbformat
 import pytest
 
 from lcvreport.measures.scheme import load_scheme
-from lcvreport.report.notebooks import MATHJAX, MATHJAX_PARTS, export_html
 
-from conftest import EXAMPLES, ROOT
+from conftest import ROOT
 
 LCV = [sys.executable, "-m", "lcvreport.cli"]
 TEMPLATE = ROOT / "examples" / "schemes" / "template.toml"
-CHROMIUM = shutil.which("chromium")
 
 
 def _links(folder: Path) -> list[Path]:
     return [p for p in folder.rglob("*") if p.is_symlink()]
 
 
-def _rendered_math(index: Path, profile: Path) -> tuple[int, bool]:
-    """(the math elements MathJax typeset, whether it reported an error) of ``index`` in headless
-    Chromium (no network, a fresh profile)."""
-    dom = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                          "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                          f"--user-data-dir={profile}", "--virtual-time-budget=20000", "--dump-dom", index.as_uri()],
-                         capture_output=True, text=True, timeout=180).stdout
-    return len(re.findall(r'<script type="math/tex', dom)), "Math Processing Error" in dom
+@pytest.fixture
+def report(scheme_report):
+    return scheme_report
 
 
-@pytest.mark.skipif(not MATHJAX.exists(), reason="no MathJax on this machine (Debian's libjs-mathjax)")
-def test_the_html_carries_its_mathjax_and_a_copy_renders_elsewhere(tmp_path):
-    nb = nbformat.v4.new_notebook()
-    nb.cells = [nbformat.v4.new_markdown_cell("Inline $a_y = u r + \\dot v$ and displayed "
-                                              "$$\\mathrm{RA} = \\frac{\\max|a_N|}{\\max|a_1|}$$")]
-    built = tmp_path / "built"
-    built.mkdir()
-    export_html(nb, built)
-    assert not _links(built)                                      # real files, nothing points outside
-    for part in MATHJAX_PARTS:
-        assert (built / "mathjax" / part).exists(), part
-    html = (built / "index.html").read_text()
-    urls = re.findall(r'<script[^>]+src="([^"]+)"', html)
-    assert urls and all(not u.startswith(("/", "file:", "http")) for u in urls), urls
-    copy = tmp_path / "elsewhere" / "deep" / "copy"
-    shutil.copytree(built, copy, symlinks=True)
-    shutil.rmtree(built)                                          # the original is gone
-    if CHROMIUM is None:
-        pytest.skip("no Chromium here to render the copy (the files are checked above)")
-    typeset, error = _rendered_math(copy / "index.html", tmp_path / "profile1")
-    assert typeset == 2 and not error
-    shutil.rmtree(copy / "mathjax")                               # the control: without it, nothing is typeset
-    assert _rendered_math(copy / "index.html", tmp_path / "profile2")[0] == 0
-
-
-@pytest.fixture(scope="module")
-def report(tmp_path_factory):
-    out = tmp_path_factory.mktemp("assess") / "report"
-    vehicle = EXAMPLES / "b_double.toml"
-    p = subprocess.run(LCV + ["assess", "--vehicle", str(vehicle), "--scheme", str(TEMPLATE), "--out", str(out),
-                              "--json"], capture_output=True, text=True, timeout=600)
-    assert p.returncode == 0, p.stderr
-    return out, vehicle, json.loads(p.stdout)
-
-
+@pytest.mark.xdist_group("scheme_report")
 def test_the_report_opens_on_the_verdict_table_and_names_what_was_assessed(report):
     out, vehicle, doc = report
     assert (out / "vehicle.toml").read_text() == vehicle.read_text()        # the user's file, as written

@@ -113,7 +113,10 @@ def test_criteria_and_studies_take_exactly_the_registry_keys(tmp_path):
         assert key in load_criteria(crit).limits
         study_from_dict({"vehicle": "tractor_semitrailer", "speed_kph": 88.0, "measures": [key],
                          "factors": {"trailer1.mass_scale": {"values": [1.0]}}})
-    for bad in ("trim_offtracking_m", "ay_gain_per_unit", "speed_mps", "hsso"):
+    crit = tmp_path / "c.toml"                          # a key of the last release: read as today's
+    crit.write_text('[limits]\n"trim_offtracking_m" = { max = 1.0, source = "test" }\n')
+    assert list(load_criteria(crit).limits) == ["trim.offtracking_m"]
+    for bad in ("ay_gain_per_unit", "speed_mps", "hsso"):
         crit = tmp_path / "c.toml"
         crit.write_text(f'[limits]\n"{bad}" = {{ max = 1.0, source = "test" }}\n')
         with pytest.raises(CriteriaError):

@@ -25,8 +25,10 @@ EXAMPLES = ("b_double", "western_double", "truck_full_trailer")
 
 def _vehicle(name):
     v = load_vehicle(ROOT / "examples" / "vehicles" / f"{name}.toml")
-    # a yaw-roll product and uneven dampers, so that every term of the equations is exercised
-    units = tuple(replace(u, yaw_roll_product_kg_m2=300.0 * (i + 1) * (-1) ** i) for i, u in enumerate(v.units))
+    # a yaw-roll product and uneven dampers, so that every term of the equations is exercised (a
+    # product a body can have: I_xz^2 < I_x I_z, which a vehicle file must meet)
+    units = tuple(replace(u, yaw_roll_product_kg_m2=(-1) ** i * min(300.0 * (i + 1), 0.05 * (
+        u.roll_inertia_kg_m2 * u.yaw_inertia_kg_m2) ** 0.5)) for i, u in enumerate(v.units))
     return replace(v, units=units)
 
 

@@ -37,8 +37,13 @@ def _cmd_fmu(args, out: _Out) -> int:
     from ..model.linear import check_model
     model = check_model(args.model)
     if model == "yaw_roll":
+        from ..measures.roll import unstable_at_rest
         from .roll import roll_vehicle
         v = roll_vehicle(args)                  # the roll keys, checked: one line naming what is missing
+        why = unstable_at_rest(v)
+        if why is not None:                     # its roll angle would grow without bound from any start
+            raise UsageError(f"argument --model yaw-roll: {v.name}: {why.removeprefix('undefined: ')}; no FMU "
+                             "was built")
     else:
         v = _vehicle(args)
     try:

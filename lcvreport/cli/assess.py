@@ -15,14 +15,30 @@ def load_scheme_option(path: str):
         raise UsageError(f"argument --scheme {path}: {exc}") from None
 
 
+def _file_bytes(path: str, what: str) -> bytes:
+    """The bytes of a file the command has read and checked already (its digest for the JSON)."""
+    from ..util.files import FileInputError, read_file_bytes
+    try:
+        return read_file_bytes(path, what)
+    except FileInputError as exc:
+        raise UsageError(f"argument {exc}") from None
+
+
 def assessment_of(args):
-    """(vehicle, scheme, assessment) of the options."""
+    """(vehicle, scheme, assessment) of the options; the assessment names the files it read
+    (their names and SHA-256)."""
+    from pathlib import Path
+
     from ..measures.assess import assess
+    from ..model.presets import preset_path
     v = _vehicle(args)
     scheme = load_scheme_option(args.scheme)
     units = _load_units(args, v) if args.load is not None else None
     sources = _sources(args, v)
-    return v, scheme, assess(v, scheme, args.tire_scale, units, sources if sources else None)
+    a = assess(v, scheme, args.tire_scale, units, sources if sources else None)
+    vehicle = (Path(args.vehicle).name, _file_bytes(args.vehicle, "vehicle file")) if args.vehicle is not None \
+        else (f"preset {args.preset}", preset_path(args.preset).read_bytes())
+    return v, scheme, a.with_files(vehicle, (Path(args.scheme).name, _file_bytes(args.scheme, "scheme file")))
 
 
 def _cmd_assess(args, out: _Out) -> int:
@@ -33,13 +49,15 @@ def _cmd_assess(args, out: _Out) -> int:
         except OutputFolderError as exc:
             raise UsageError(f"argument {exc}") from None
     v, scheme, a = assessment_of(args)
-    if args.out is not None:
-        _write_report(args, a)
+    # the verdict first: a report interrupted or failing after it leaves the verdict said
     if args.json:
         out.json(a.to_dict())
-        return 0
-    for line in verdict_lines(a):
-        out.line(line)
+    else:
+        for line in verdict_lines(a):
+            out.line(line)
+    out.flush()
+    if args.out is not None:
+        _write_report(args, a)
     return 0
 
 
@@ -58,7 +76,7 @@ def _write_report(args, a) -> None:
         if src else None
     run_report("lcv assess", lambda: build_scheme_report(
         a.vehicle, args.scheme, args.out, a.tire_scale, a.load_units or None, residuals, pdf=not args.no_pdf,
-        paper=args.paper, source=args.vehicle or f"preset {args.preset}", vehicle_text=text,
+        paper=args.paper, source=a.files["vehicle"]["name"], vehicle_text=text,
         progress=lambda line: print(f"lcv assess: {line}", file=sys.stderr, flush=True)),
         lambda line: print(f"lcv assess: {line}", file=sys.stderr))
 
@@ -67,24 +85,29 @@ def verdict_lines(a) -> list[str]:
     """The verdict table as text lines: a header naming the scheme and its status, one line per
     measure (conditions, value, the verdict at every level, the level reached), the vehicle's
     level, and the reason of every measure that does not reach the first level."""
+    from ..measures.assess import VERDICT_WORDS
     s = a.scheme
     status = {"template": " -- a TEMPLATE: its numbers are placeholders, not a standard",
               "draft": " -- a DRAFT"}.get(s.status, "")
-    lines = [f"{a.vehicle.name} assessed against {s.name}{status}",
+    lines = [f"{a.vehicle.name} assessed against {_line(s.name)}{status}",
              f"  levels, most demanding first: {', '.join(s.levels)}; tire scale {a.tire_scale:g}"]
     width = max(8, *(len(level) for level in s.levels))
-    head = f"  {'measure':<28} {'conditions':<32} {'value':>10} {'unit':<5}"
+    vw = max(10, *(len(m.value_text()) for m in a.measures))
+    head = f"  {'measure':<28} {'conditions':<32} {'value':>{vw}} {'unit':<5}"
     lines.append(head + "".join(f" {level:>{width}}" for level in s.levels) + "  reached")
-    word = {"pass": "pass", "fail": "FAIL", "not computed": "n/c"}
     for m in a.measures:
-        value = "none" if m.value is None else f"{m.value:.4g}"
-        row = f"  {m.key:<28} {m.conditions_text():<32} {value:>10} {m.unit:<5}"
-        lines.append(row + "".join(f" {word[m.verdicts[level]]:>{width}}" for level in s.levels)
+        row = f"  {m.key:<28} {m.conditions_text():<32} {m.value_text():>{vw}} {m.unit:<5}"
+        lines.append(row + "".join(f" {VERDICT_WORDS[m.verdicts[level]]:>{width}}" for level in s.levels)
                      + f"  {m.level_reached or 'none'}")
     lines.append(f"  level reached by the vehicle: {a.level_reached or 'none'}"
                  + (f" ({_line(a.reason)})" if a.reason else ""))
+    from ..measures.registry import MEASURES
     for m in a.measures:
         if m.reason:
             lines.append(f"  {m.key}: {_line(m.reason)}")
-    lines.append("  (n/c: not computed, the reason above; limits and sources: lcv assess --json, or the report)")
+    for m in a.measures:
+        if MEASURES[m.key].caveat:
+            lines.append(f"  {m.key}: {MEASURES[m.key].caveat}")
+    lines.append("  (n/c: not computed, the reason above; limits, margins and sources: lcv assess --json, or the "
+                 "report)")
     return lines

@@ -108,7 +108,10 @@ def build_parser() -> argparse.ArgumentParser:
             load(sp, load_required)
         sp.add_argument("--json", action="store_true", help="machine-readable output")
 
-    common(sub.add_parser("eig", help="eigenvalues [1/s], damped frequency, damping ratio"), None)
+    eig = sub.add_parser("eig", help="eigenvalues [1/s], damped frequency, damping ratio")
+    common(eig, None)
+    eig.add_argument("--model", default="yaw-plane", choices=("yaw-plane", "yaw-roll"),
+                     help="the model: yaw-plane (default) or yaw-roll (the vehicle's roll keys, docs/roll.md)")
     mat = sub.add_parser("matrices", help="M, S (and F with --load)")
     common(mat, False)
     mat.add_argument("--units", choices=("thesis", "si"), default=None,
@@ -129,6 +132,10 @@ def build_parser() -> argparse.ArgumentParser:
         from ..measures.registry import CONDITIONS
         for c in CONDITIONS.values():
             if c.key in ("speed_kph", "crossfall_percent"):
+                continue
+            if c.choices:                          # a choice (the RA reference points), not a number
+                sp.add_argument(c.option, dest=c.key, choices=c.choices,
+                                help=c.definition.replace("%", "%%") + (f"; default {c.default}" if c.default else ""))
                 continue
             sp.add_argument(c.option, dest=c.key, type=_ranged(c.range, unit=c.unit, what=c.label), metavar="X",
                             help=c.definition.replace("%", "%%") + f" [{c.unit}], in "

@@ -61,15 +61,43 @@ def _cmd_measures(args, out: _Out) -> int:
     m, doc = sets[0], docs[0]
     out.line(f"{v.name} at {args.speed_kph or args.speed_mph} {unit} ({mps_to_kph(m.speed_mps):.1f} km/h), tire scale "
              f"{args.tire_scale:g}")
-    for row in m.rows():
-        val = row["value"]
-        text = val if isinstance(val, str) else f"{val:.6g}"
-        out.line(f"  {row['measure']:42s} {text:>12s} {row['unit']:10s} {row['note']}")
+    for line in text_lines(m.rows()):
+        out.line(line)
     if criteria is not None:
         out.line(f"verdicts against {args.criteria} (limits and their sources as the file gives them):")
         for key, verdict in doc["verdicts"].items():
             out.line(f"  {key:28s} {verdict['verdict']:14s} {verdict['note']}")
     return 0
+
+
+def text_lines(rows: list[dict]) -> list[str]:
+    """The measures as aligned text: columns as wide as their longest entry, and a reason that
+    many rows share (a vehicle without roll data: one missing key for every roll measure) said
+    once, the rows pointing to it.
+
+    Examples
+    --------
+    >>> rows = [{"measure": "a", "value": 1.0, "unit": "m", "note": "why"},
+    ...         {"measure": "a longer label", "value": "none", "unit": "-", "note": "x"}]
+    >>> print("\\n".join(text_lines(rows)))
+      a                 1 m  why
+      a longer label none -  x
+    """
+    from collections import Counter
+    texts = [row["value"] if isinstance(row["value"], str) else f"{row['value']:.6g}" for row in rows]
+    shared = Counter(row["note"] for row, text in zip(rows, texts) if text == "none")
+    repeated = [note for note, count in shared.items() if count >= 3 and len(note) > 40]
+    label = max(len(row["measure"]) for row in rows)
+    value = max(len(t) for t in texts)
+    unit = max(len(row["unit"]) for row in rows)
+    lines = []
+    for row, text in zip(rows, texts):
+        note = row["note"]
+        if text == "none" and note in repeated:
+            note = f"not computed: see note {repeated.index(note) + 1} below"
+        lines.append(f"  {row['measure']:<{label}} {text:>{value}} {row['unit']:<{unit}}  {note}".rstrip())
+    lines += [f"  note {k + 1}: {note}" for k, note in enumerate(repeated)]
+    return lines
 
 
 def _flatten(doc: dict, vehicle) -> dict:

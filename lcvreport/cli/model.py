@@ -24,8 +24,14 @@ def _cmd_presets(args, out: _Out) -> int:
 
 def _cmd_eig(args, out: _Out) -> int:
     from ..analysis.modes import modes
-    v = _vehicle(args)
-    m = modes(v, _speed_mps(args), args.tire_scale)
+    from ..model.linear import check_model
+    model = check_model(args.model)
+    if model == "yaw_roll":
+        from .roll import roll_vehicle
+        v = roll_vehicle(args)                    # the roll keys, checked: one line naming what is missing
+    else:
+        v = _vehicle(args)
+    m = modes(v, _speed_mps(args), args.tire_scale, model=model)
     _finite(m.eigenvalues)
     k = m.least_damped
     if args.json:

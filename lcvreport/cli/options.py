@@ -213,7 +213,23 @@ def _parse_speeds(args: argparse.Namespace) -> tuple[list[float], str]:
     return [val * factor for val in values], unit
 
 
+#: the longest message line [characters]: a message quoting a user's file (ten thousand levels, a
+#: list of paths) is cut, never a screenful
+MESSAGE_CHARS = 600
+
+
 def _line(text) -> str:
-    """``text`` as one line of plain text: every character that is not printable (a newline, an
-    ESC that would drive the terminal) escaped, so a message quoting a user's file is one line."""
-    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(text))
+    """``text`` as one short line of plain text: every character that is not printable (a newline,
+    an ESC that would drive the terminal) escaped, so a message quoting a user's file is one line;
+    at most :data:`MESSAGE_CHARS` characters (the cut marked and counted).
+
+    Examples
+    --------
+    >>> _line("a\\nb"), len(_line("x" * 10_000)) <= MESSAGE_CHARS
+    ('a\\\\nb', True)
+    """
+    line = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(text))
+    if len(line) <= MESSAGE_CHARS:
+        return line
+    kept = MESSAGE_CHARS - 40                       # room for the mark, whatever the count
+    return line[:kept] + f" ... ({len(line) - kept} characters more)"

@@ -31,6 +31,9 @@ class _Out:
     def line(self, text: str = "") -> None:
         self.stream.write(text + "\n")
 
+    def flush(self) -> None:
+        self.stream.flush()
+
     def json(self, doc) -> None:
         try:
             text = json.dumps(doc, allow_nan=False)
@@ -50,6 +53,9 @@ def _write_figure_new(fig, path: Path) -> None:
     import os
     import tempfile
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.fchmod(fd, 0o666 & ~umask)                  # as open() would create it (mkstemp makes 0600)
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=150)

@@ -42,7 +42,7 @@ from .c_tree import (INCLUDE_DIRS, LOADER_HEADERS, LOADER_INCLUDE_DIRS, LOADER_S
                      STUB_SOURCES)
 from .description_common import guid
 from .description_fmi2 import model_description
-from .interface import U_START, Interface, preset_interface, vehicle_interface
+from .interface import U_START, Interface, fmu_base_name, preset_interface, vehicle_interface
 from .package import SOURCES_README, _package_copy, _zip, bundled_package_name, documentation_files
 
 
@@ -260,25 +260,28 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
         Start value of the input ``u`` [m/s] (default 50 mph).
     fmi : {2, 3}
     model : {"yaw_plane", "yaw_roll"}
-        The linear model built in (:func:`~lcvreport.fmu.interface.vehicle_interface`); the
-        file names are the same for both.
+        The linear model built in (:func:`~lcvreport.fmu.interface.vehicle_interface`).  The
+        yaw plane's FMUs are named for the vehicle, another model's for the vehicle and the model
+        (``<name>_yaw_roll.fmu``, ``<name>_yaw_rollNative.fmu``, ...): both kinds of one vehicle
+        sit in one folder and load into one host (their model identifiers differ).
     """
     if kind not in ("python", "native", "both"):
         raise ValueError(f"kind must be python, native or both, got {kind!r}")
     if fmi not in (2, 3):
         raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
     itf = vehicle_interface(vehicle, u_start_mps, model)
+    name = fmu_base_name(vehicle.name, model)
     out = []
     if fmi == 3:
         if kind in ("python", "both"):
-            out.append(build_python_fmu3(itf, Path(out_dir), fmi3_python_name(vehicle.name)))
+            out.append(build_python_fmu3(itf, Path(out_dir), fmi3_python_name(name)))
         if kind in ("native", "both"):
-            out.append(build_native_fmu3(itf, Path(out_dir), f"{vehicle.name}Native3"))
+            out.append(build_native_fmu3(itf, Path(out_dir), f"{name}Native3"))
         return out
     if kind in ("python", "both"):
-        out.append(build_python_fmu(itf, Path(out_dir), vehicle.name))
+        out.append(build_python_fmu(itf, Path(out_dir), name))
     if kind in ("native", "both"):
-        out.append(build_native_fmu(itf, Path(out_dir), f"{vehicle.name}Native"))
+        out.append(build_native_fmu(itf, Path(out_dir), f"{name}Native"))
     return out
 
 

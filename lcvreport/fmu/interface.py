@@ -338,6 +338,18 @@ def preset_interface() -> Interface:
                      "zero-order-hold stepping for any communication step size.")
 
 
+def fmu_base_name(vehicle_name: str, model: str = "yaw_plane") -> str:
+    """The stem of a vehicle's FMUs of ``model``: the vehicle's name for the yaw plane, with the
+    model's name appended for any other (``b_double_yaw_roll``).
+
+    Examples
+    --------
+    >>> fmu_base_name("b_double"), fmu_base_name("b_double", "yaw_roll")
+    ('b_double', 'b_double_yaw_roll')
+    """
+    return vehicle_name if model == "yaw_plane" else f"{vehicle_name}_{model}"
+
+
 def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START, model: str = "yaw_plane") -> Interface:
     """The interface of an FMU with ``vehicle`` built in (docs/fmu.md); the input ``u``
     starts at ``u_start_mps`` [m/s] (default 50 mph).
@@ -430,4 +442,4 @@ def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START, model: str
     desc = (f"Linear {kind} model of {vehicle.name} ({n} units: {', '.join(vehicle.unit_names)}) with residual "
             "tire forces (conicity, ply steer). Exact zero-order-hold stepping for any communication step size."
             + (f" {vehicle.description}" if vehicle.description else ""))
-    return Interface(vehicle.name, tuple(t.vars), (vehicle,), False, desc, model)
+    return Interface(fmu_base_name(vehicle.name, model), tuple(t.vars), (vehicle,), False, desc, model)

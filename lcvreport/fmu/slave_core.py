@@ -34,6 +34,21 @@ def _interface(resources: str):
                              cfg.get("u_start_mps", U_START), cfg.get("model", "yaw_plane"))
 
 
+def _quietly(method):
+    """The FMI call with numpy's floating-point warnings and Python's warnings kept inside the FMU:
+    a host's stderr gets no RuntimeWarning naming the FMU's temporary files (what is wrong is the
+    call's status and logged message), and the host's own warning settings are left as they were."""
+    import functools
+    import warnings
+
+    @functools.wraps(method)
+    def call(self, *args):
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            return method(self, *args)
+    return call
+
+
 class SlaveCore:
     """One instance: one vehicle (or the six presets) through the interface table."""
 
@@ -95,6 +110,7 @@ class SlaveCore:
     def enter_initialization_mode(self):
         pass
 
+    @_quietly
     def exit_initialization_mode(self):
         try:
             if self.initialized:
@@ -116,8 +132,12 @@ class SlaveCore:
             self.init_error = f"initialization failed: {type(exc).__name__}: {exc}"
             self._error(self.init_error)
 
+    @_quietly
     def do_step(self, current_time, step_size):
         try:
+            if not math.isfinite(current_time):
+                self._error(f"{self._fn('DoStep')}: currentCommunicationPoint is not finite ({current_time!r})")
+                return False
             if self.engine is None:
                 self._error(self.init_error and f"{self.init_error}; every doStep will be refused"
                             or f"{self._fn('DoStep')} called before initialization completed")
@@ -158,6 +178,7 @@ class SlaveCore:
         self._prefix = values[:first].tolist()
         return values
 
+    @_quietly
     def get_real(self, vrs):
         try:
             same = type(vrs) is list and vrs == self._last_get   # (a list: an array would compare elementwise)

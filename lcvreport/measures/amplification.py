@@ -317,12 +317,12 @@ def _golden(batch: VariantBatch, speed_mps, tire_scale, idx, a, c) -> np.ndarray
     return 0.5 * (a + c)
 
 
-def single_sine_batched(batch: VariantBatch, speed_mps: float, f_hz: float | None = None,
-                        tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """(RA, yaw-rate RA) of the single sine [-] of every variant: max|a_N| / max|a_1| and
-    max|r_N| / max|r_1| on the continuous exact response
-    (:func:`lcvreport.measures.amplification.single_sine`: ``delta0 sin(2 pi f t)`` for one
-    period, then the tail)."""
+def single_sine_peaks(batch: VariantBatch, speed_mps: float, f_hz: float | None = None, tire_scale: float = 1.0,
+                      extra=()) -> np.ndarray:
+    """The peaks over the single sine (continuous, exact) of every variant, shape (B, 4 + k):
+    max|a_1|, max|a_N|, max|r_1|, max|r_N| and of each of the ``k`` signals of ``extra``, each a
+    triple ``(X, XD, D)`` of the variants' rows ``y = X x + XD x' + D delta`` (shapes (B, n), (B, n),
+    (B,)): a yaw-roll model's sprung-CG acceleration, the steered axle's."""
     from ..analysis.batch import RESPONSE_GROUP
     from ..analysis.frequency import RA_FREQUENCY_HZ, _freq
     from ..manoeuvres.steer import sine
@@ -333,19 +333,35 @@ def single_sine_batched(batch: VariantBatch, speed_mps: float, f_hz: float | Non
     ay_rows = batch.ay_rows(speed_mps, [0, last])
     r_map = linear_model(batch.vehicle, batch.model).yaw_rate_map()[[0, last]]
 
-    def signals(Mz, d_row, ctx):
-        n = ctx[3]
-        C = np.zeros((Mz.shape[0], 4, Mz.shape[-1]))
-        C[:, :2] = ay_rows(Mz, d_row, ctx)                    # a_1, a_N
-        C[:, 2:, :n] = r_map                                  # r_1, r_N
-        return C
+    def signals_of(rows):
+        def signals(Mz, d_row, ctx):
+            n = ctx[3]
+            C = np.zeros((Mz.shape[0], 4 + len(extra), Mz.shape[-1]))
+            C[:, :2] = ay_rows(Mz, d_row, ctx)                    # a_1, a_N
+            C[:, 2:4, :n] = r_map                                 # r_1, r_N
+            for k, rows_k in enumerate(extra):                    # X x + XD x' + D delta
+                X, XD, D = (np.asarray(a)[rows] for a in rows_k)
+                C[:, 4 + k, :n] = X
+                C[:, 4 + k] += np.einsum("bn,bnd->bd", XD, Mz[:, :n])
+                C[:, 4 + k] += D[:, None] * d_row
+            return C
+        return signals
     peaks = []
     for g in range(0, batch.size, RESPONSE_GROUP):
         rows = np.arange(g, min(batch.size, g + RESPONSE_GROUP))
-        hi, lo = batch.extremes(speed_mps, steer, t_end, SINGLE_SINE_STEP_S, signals, tire_scale, rows,
+        hi, lo = batch.extremes(speed_mps, steer, t_end, SINGLE_SINE_STEP_S, signals_of(rows), tire_scale, rows,
                                 positions=False)
         peaks.append(np.maximum(np.abs(hi), np.abs(lo)))
-    peaks = np.concatenate(peaks)
+    return np.concatenate(peaks)
+
+
+def single_sine_batched(batch: VariantBatch, speed_mps: float, f_hz: float | None = None,
+                        tire_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(RA, yaw-rate RA) of the single sine [-] of every variant: max|a_N| / max|a_1| and
+    max|r_N| / max|r_1| on the continuous exact response
+    (:func:`lcvreport.measures.amplification.single_sine`: ``delta0 sin(2 pi f t)`` for one
+    period, then the tail)."""
+    peaks = single_sine_peaks(batch, speed_mps, f_hz, tire_scale)
     return peaks[:, 1] / peaks[:, 0], peaks[:, 3] / peaks[:, 2]
 
 

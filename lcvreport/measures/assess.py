@@ -44,6 +44,13 @@ from .scheme import Scheme
 NO_SPEED_KPH = 88.0
 
 
+#: the RA reference points as a verdict table names them
+POINTS = {"sprung_cg": "the rearmost unit's sprung CG", "roll_axis": "the rearmost unit's roll axis",
+          "steer_axle": "the steered axle", "cg": "unit 1's CG"}
+#: the verdicts as a verdict table writes them (a failure in capitals, to stand out)
+VERDICT_WORDS = {"pass": "pass", "fail": "FAIL", "not computed": "n/c"}
+
+
 @dataclass(frozen=True)
 class MeasureVerdict:
     """One measure of the scheme: its value under its ``conditions``, the verdict and the
@@ -58,7 +65,20 @@ class MeasureVerdict:
     level_reached: str | None
     reason: str | None
     #: every level's bounds as numbers, relative ones resolved: {level: (min or None, max or None)}
+    #: (finite ones: what a drawing can show)
     bounds: dict = dataclasses.field(default_factory=dict)
+    #: what a null value is known to be at least (the yaw damping coefficient of a vehicle whose
+    #: every joint is heavily damped), else None
+    lower_bound: float | None = None
+    #: per level, how far inside its limit the value is (negative: how far outside), in the
+    #: measure's unit; None where not computed or judged on the lower bound
+    margins: dict = dataclasses.field(default_factory=dict)
+    #: per level, the limit as numbers with every relative bound resolved: ``{"min", "max"}``
+    #: (None where the level sets none or the bound is no finite number: relative to a null
+    #: measure, or overflowed -- :attr:`limit_texts` says which)
+    resolved: dict = dataclasses.field(default_factory=dict)
+    #: per level, the resolved limit as a reader reads it (``<= 5.7 × 0.4799 = 2.736``)
+    limit_texts: dict = dataclasses.field(default_factory=dict)
 
     @property
     def unit(self) -> str:
@@ -68,11 +88,45 @@ class MeasureVerdict:
     def label(self) -> str:
         return MEASURES[self.key].label
 
+    @property
+    def title(self) -> str:
+        """The measure in the standards' words (:attr:`Measure.title`)."""
+        return MEASURES[self.key].title
+
+    def value_text(self, digits: int = 4) -> str:
+        """The value as a verdict table shows it: the number, ``>= 0.6901 (every joint heavily
+        damped)`` for a null known by its lower bound, or ``none``."""
+        if self.value is not None:
+            return f"{self.value:.{digits}g}"
+        if self.lower_bound is not None:
+            why = " (every joint heavily damped)" if self.key == "yaw_damping_coefficient" else ""
+            return f">= {self.lower_bound:.{digits}g}{why}"
+        return "none"
+
+    def cell(self, level: str) -> str:
+        """The verdict table's cell of ``level``: the verdict, the limit as a number (a relative
+        one resolved) and the signed margin (``FAIL <= 0.5 (-0.02521)``: positive inside the
+        limit, negative outside)."""
+        word = VERDICT_WORDS[self.verdicts[level]]
+        if self.verdicts[level] == "not computed":
+            return word
+        b = self.resolved.get(level) or {}
+        bound = " and ".join(f"{sign} {b[k]:.4g}" for k, sign in (("min", ">="), ("max", "<=")) if b.get(k) is not None)
+        if not bound:                                   # an infinite bound: the text says how
+            bound = self.limit_texts[level].rsplit(" = ", 1)[-1]
+        bound = ("|x| " if self.limits[level].startswith("|") else "") + bound
+        margin = self.margins.get(level)
+        how = f"value {self.value_text()}" if margin is None else f"{margin:+.4g}"
+        return f"{word} {bound} ({how})"
+
     def conditions_text(self) -> str:
         """The conditions as a person reads them: ``100 km/h, A0 0.15 g, F 0.4 Hz``."""
         parts = []
         for k, v in self.conditions.items():
             c = CONDITIONS[k]
+            if c.choices:
+                parts.append(f"{c.short} {POINTS.get(v, v)}")
+                continue
             unit = "°" if c.unit == "deg" else f" {c.unit}"
             parts.append(f"{c.short} {v:g}{unit}".strip())
         if parts:
@@ -80,9 +134,14 @@ class MeasureVerdict:
         return "quasi-static" if MEASURES[self.key].family == "rollover" else "-"
 
     def to_dict(self) -> dict:
-        return {"key": self.key, "conditions": dict(self.conditions), "value": self.value,
+        """The measure's entry of ``lcv assess --json`` (docs/assessment.md)."""
+        return {"key": self.key, "standard": MEASURES[self.key].standard, "label": self.label,
+                "caveat": MEASURES[self.key].caveat or None,
+                "conditions": dict(self.conditions), "value": self.value, "lower_bound": self.lower_bound,
                 "verdicts": dict(self.verdicts), "level_reached": self.level_reached, "reason": self.reason,
-                "unit": self.unit, "limits": dict(self.limits)}
+                "unit": self.unit, "limits": dict(self.limits),
+                "limits_resolved": {level: dict(b) for level, b in self.resolved.items()},
+                "margins": dict(self.margins)}
 
 
 @dataclass(frozen=True)
@@ -99,33 +158,77 @@ class SchemeAssessment:
     load_units: tuple = ()
     #: the residual sources beyond the 1 % rule (the crossfall: each measure's condition)
     sources: object = None
+    #: the files assessed, as ``lcv assess`` read them: {"vehicle": {"name", "sha256"}, "scheme":
+    #: {...}} (empty for an assessment of objects)
+    files: dict = dataclasses.field(default_factory=dict)
 
     def evidence(self, key: str):
         """The :class:`~lcvreport.measures.evidence.Evidence` of the measure ``key``."""
         from .evidence import evidence
         return evidence(self, next(m for m in self.measures if m.key == key))
 
+    def with_files(self, vehicle: tuple[str, bytes] | None = None, scheme: tuple[str, bytes] | None = None
+                   ) -> "SchemeAssessment":
+        """The assessment naming the files it read: ``(name, bytes)`` of the vehicle file and the
+        scheme file (their SHA-256 goes into the JSON and the report)."""
+        import hashlib
+        files = dict(self.files)
+        for kind, item in (("vehicle", vehicle), ("scheme", scheme)):
+            if item is not None:
+                files[kind] = {"name": item[0], "sha256": hashlib.sha256(item[1]).hexdigest()}
+        return dataclasses.replace(self, files=files)
+
     def to_dict(self) -> dict:
-        """``{"scheme", "levels", "measures": [{"key", "conditions", "value", "verdicts",
-        "level_reached", "reason", "unit", "limits"}], "level_reached"}`` (docs/assessment.md)."""
-        return {"scheme": self.scheme.name, "levels": list(self.scheme.levels),
-                "measures": [m.to_dict() for m in self.measures], "level_reached": self.level_reached}
+        """The JSON of ``lcv assess --json`` (docs/assessment.md): the scheme, its levels, the
+        vehicle, lcvreport's version, the files' SHA-256, every measure (value, lower bound,
+        verdicts, resolved limits, margins, reason), the level the vehicle reaches and why not
+        the first."""
+        from importlib.metadata import version
+        return {"scheme": self.scheme.name, "status": self.scheme.status, "levels": list(self.scheme.levels),
+                "vehicle": self.vehicle.name, "lcvreport_version": version("lcvreport"),
+                "files": {k: dict(v) for k, v in self.files.items()}, "tire_scale": self.tire_scale,
+                "measures": [m.to_dict() for m in self.measures], "level_reached": self.level_reached,
+                "reason": self.reason}
+
+    def level_columns(self) -> dict:
+        """{column key of :meth:`rows`: the level's name} -- the level columns carry keys of
+        their own, so that a level named ``value`` or ``L1_kph`` is a level, not a column of the
+        table or a unit suffix."""
+        return {f"verdict at level {k + 1}": level for k, level in enumerate(self.scheme.levels)}
 
     def rows(self) -> list[dict]:
-        """The verdict table: one row per measure -- the measure, its conditions, the value and
-        unit, the verdict at every level, the level it reaches -- and a last row for the vehicle."""
+        """The verdict table: one row per measure -- the measure in the standard's words and its
+        key, its conditions, the value and unit, per level the verdict with the resolved limit and
+        the margin (:meth:`level_columns` names those columns), the level it reaches -- and a last
+        row for the vehicle."""
+        cols = self.level_columns()
         rows = []
         for m in self.measures:
-            row = {"measure": m.label, "key": m.key, "conditions": m.conditions_text(),
-                   "value": "none" if m.value is None else f"{m.value:.4g}", "unit": m.unit}
-            row.update({level: m.verdicts[level] for level in self.scheme.levels})
+            caveat = MEASURES[m.key].caveat
+            row = {"measure": f"{m.title} ({m.key})" + (f"; {caveat.split(':')[0]}" if caveat else ""),
+                   "key": m.key, "conditions": m.conditions_text(),
+                   "value": m.value_text(), "unit": m.unit}
+            row.update({col: m.cell(level) for col, level in cols.items()})
             row["level reached"] = m.level_reached or "none"
             rows.append(row)
         last = {"measure": "the vehicle", "key": "", "conditions": "", "value": "", "unit": ""}
-        last.update({level: "pass" if all(m.verdicts[level] == "pass" for m in self.measures) else "fail"
-                     for level in self.scheme.levels})
+        last.update({col: "pass" if all(m.verdicts[level] == "pass" for m in self.measures) else "FAIL"
+                     for col, level in cols.items()})
         last["level reached"] = self.level_reached or "none"
         rows.append(last)
+        return rows
+
+    def limit_rows(self) -> list[dict]:
+        """The limits, one row per measure: its conditions, every level's limit as the scheme
+        writes it (resolved where relative) and its source -- once when every level shares it."""
+        rows = []
+        for sm, m in zip(self.scheme.measures, self.measures):
+            row = {"measure": f"{m.title} ({m.key})", "conditions": m.conditions_text()}
+            row.update({col: m.limit_texts[level] for col, level in self.level_columns().items()})
+            sources = list(dict.fromkeys(sm.limits[level].source for level in self.scheme.levels))
+            row["source"] = sources[0] if len(sources) == 1 else "; ".join(
+                f"{level}: {sm.limits[level].source}" for level in self.scheme.levels)
+            rows.append(row)
         return rows
 
     def table(self):
@@ -156,7 +259,8 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     Parameters
     ----------
     vehicle : Vehicle
-    scheme : lcvreport.measures.scheme.Scheme
+    scheme : lcvreport.measures.scheme.Scheme or path
+        The scheme, or a scheme file's path (read and checked: :func:`~lcvreport.measures.scheme.load_scheme`).
     tire_scale : float
     load_units : list of str, optional
         Units carrying the 1 % rule: a residual source of the trim and the straight path.
@@ -167,8 +271,16 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     -------
     SchemeAssessment
     """
+    from ..model.vehicle import check_vehicle
     from ..model.yaw_plane.loads import ResidualSources
     from .measure_set import measure_values
+    check_vehicle(vehicle)
+    if isinstance(scheme, (str, bytes)) or hasattr(scheme, "__fspath__"):   # a scheme file's path: read it
+        from .scheme import load_scheme
+        scheme = load_scheme(scheme)
+    if not isinstance(scheme, Scheme):
+        raise TypeError(f"scheme must be a Scheme (lcvreport.measures.scheme.load_scheme(path)) or a scheme file's "
+                        f"path, got the {type(scheme).__name__}")
     if sources is not None and sources.crossfall_percent:
         raise ValueError("the crossfall is a condition of the scheme (crossfall_percent), not a source here")
     verdicts = {}
@@ -181,12 +293,14 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
         keys = list(dict.fromkeys([k for m in g["members"] for k in (m.key, *m.references)]))
         if "yaw_damping_coefficient" in keys:
             keys.append("yaw_damping_lower_bound")
+        if any(k.startswith("trim.") for k in keys):           # the trim is one result: both of its keys
+            keys += [k for k in ("trim.delta_rad", "trim.offtracking_m") if k not in keys]
         reasons = {}
         values = measure_values(vehicle, speed, keys, tire_scale, load_units, f_hz, src if src else None,
                                 others, reasons=reasons)
         doc = dict(values)
         if any(k.startswith("trim.") for k in keys):
-            doc["trim"] = None if values.get("trim.offtracking_m") is None else {
+            doc["trim"] = None if values.get("trim.delta_rad") is None else {
                 "delta_rad": values.get("trim.delta_rad"), "offtracking_m": values.get("trim.offtracking_m")}
             why = reasons.get("trim.offtracking_m") or reasons.get("trim.delta_rad")
             if why:
@@ -211,10 +325,12 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
 
 
 def _verdict(m, doc: dict, levels) -> MeasureVerdict:
+    from .criteria import null_lower_bound
     judged = {level: judge(Criteria({m.key: m.limits[level]}), doc)[m.key] for level in levels}
     verdicts = {level: j["verdict"] for level, j in judged.items()}
     notes = {level: j["note"] for level, j in judged.items()}
     value = judged[levels[0]]["value"]
+    lower = null_lower_bound(doc, m.key)
     reached = next((level for level in levels if verdicts[level] == "pass"), None)
     if any(v == "not computed" for v in verdicts.values()):
         reason = next(notes[level] for level in levels if verdicts[level] == "not computed")
@@ -226,8 +342,45 @@ def _verdict(m, doc: dict, levels) -> MeasureVerdict:
     else:
         reason = None
     limits = {level: m.limits[level].text() for level in levels}
-    bounds = {}
+    bounds, resolved, margins, texts = {}, {}, {}, {}
     for level in levels:
-        lim = m.limits[level].resolved(lambda k: doc.get(k))
-        bounds[level] = tuple(None if b is None or not np.isfinite(b) else float(b) for b in (lim.min, lim.max))
-    return MeasureVerdict(m.key, dict(m.conditions), value, verdicts, limits, notes, reached, reason, bounds)
+        spec = m.limits[level]
+        lim = spec.resolved(lambda k: doc.get(k))
+        nums = tuple(None if b is None else float(b) for b in (lim.min, lim.max))
+        bounds[level] = tuple(None if b is None or not np.isfinite(b) else b for b in nums)
+        resolved[level] = {"min": bounds[level][0], "max": bounds[level][1]}
+        texts[level] = _limit_text(spec, nums, doc)
+        margins[level] = _margin(value, nums, spec.absolute) if verdicts[level] != "not computed" else None
+    return MeasureVerdict(m.key, dict(m.conditions), value, verdicts, limits, notes, reached, reason, bounds,
+                          lower, margins, resolved, texts)
+
+
+def _margin(value, bounds: tuple, absolute: bool) -> float | None:
+    """How far inside its bounds ``value`` is (negative: outside), or None for a null value."""
+    if value is None:
+        return None
+    x = abs(value) if absolute else value
+    lo, hi = bounds
+    gaps = ([x - lo] if lo is not None else []) + ([hi - x] if hi is not None else [])
+    with np.errstate(invalid="ignore"):
+        g = float(min(gaps))
+    return g if np.isfinite(g) else None
+
+
+def _limit_text(spec, bounds: tuple, doc: dict) -> str:
+    """A level's limit as a reader reads it: ``<= 0.6``, ``>= 0.15``, and a relative bound with
+    its factor, the measure's value and the product (``<= 5.7 × 0.4799 = 2.736``)."""
+    from .criteria import Relative, _value
+    v = f"|{spec.key}|" if spec.absolute else ""
+    parts = []
+    for sign, b, num in ((">=", spec.min, bounds[0]), ("<=", spec.max, bounds[1])):
+        if b is None:
+            continue
+        if isinstance(b, Relative):
+            ref = _value(doc, b.key)
+            shown = "null" if ref is None else f"{ref:.4g}"
+            result = "not computed" if num is None or np.isnan(num) else f"{num:.4g}"
+            parts.append(f"{sign} {b.factor:g} × {b.key} = {b.factor:g} × {shown} = {result}")
+        else:
+            parts.append(f"{sign} {num:.4g}")
+    return (v + " " if v else "") + " and ".join(parts)

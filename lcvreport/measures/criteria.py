@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from ..util.files import FileInputError, read_toml_file
-from .registry import CRITERIA_KEYS, unknown_key_message
+from .registry import CRITERIA_KEYS, canonical, unknown_key_message
 
 #: keys a limit may name: every scalar measure of the registry (its spelling, as ``lcv measures --json``)
 KEYS = CRITERIA_KEYS
@@ -92,7 +92,8 @@ class Limit:
             if not isinstance(b, Relative):
                 return b
             x = lookup(b.key)
-            return b.factor * (math.nan if x is None else np.asarray(x, dtype=float))
+            with np.errstate(over="ignore", invalid="ignore"):     # 1e308 * 2 is inf: a bound all the same
+                return b.factor * (math.nan if x is None else np.asarray(x, dtype=float))
         return Limit(self.key, value(self.min), value(self.max), self.source, self.absolute)
 
 
@@ -123,6 +124,7 @@ def load_criteria(path: str | Path) -> Criteria:
         raise CriteriaError("needs a [limits] table (and an optional description), nothing else")
     limits = {}
     for key, spec in doc["limits"].items():
+        key = canonical(key)                      # a key of an earlier release is its alias
         if key not in KEYS:
             raise CriteriaError(f"limits.{key}: {unknown_key_message(key)}")
         if not isinstance(spec, dict) or set(spec) - {"min", "max", "source", "abs"}:
@@ -158,11 +160,12 @@ def _relative(key: str, name: str, text: str) -> Relative:
     factor = 1.0 if m.group(1) is None else float(m.group(1))
     if not math.isfinite(factor):
         raise CriteriaError(f"limits.{key}.{name}: the factor must be finite, got {m.group(1)!r}")
-    if m.group(2) not in KEYS:
-        raise CriteriaError(f"limits.{key}.{name}: {unknown_key_message(m.group(2))}")
-    if m.group(2) == key:
+    ref = canonical(m.group(2))
+    if ref not in KEYS:
+        raise CriteriaError(f"limits.{key}.{name}: {unknown_key_message(ref)}")
+    if ref == key:
         raise CriteriaError(f"limits.{key}.{name}: a limit cannot be relative to its own measure")
-    return Relative(factor, m.group(2))
+    return Relative(factor, ref)
 
 
 def _value(doc: dict, key: str):
@@ -200,8 +203,10 @@ def judge_values(lim: Limit, values, lower_bounds=None):
         x = np.abs(x)
     if lim.references:
         raise ValueError(f"limit on {lim.key}: resolve its relative bounds first (Limit.resolved)")
-    bounds_known = np.isfinite(np.broadcast_to(np.asarray(lim.min if lim.min is not None else 0.0, float), x.shape)) & \
-        np.isfinite(np.broadcast_to(np.asarray(lim.max if lim.max is not None else 0.0, float), x.shape))
+    # a bound is known unless NaN (a null measure it is relative to); an infinite one (a relative
+    # bound that overflowed) is a bound all the same: every value is below +inf
+    bounds_known = ~np.isnan(np.broadcast_to(np.asarray(lim.min if lim.min is not None else 0.0, float), x.shape)) & \
+        ~np.isnan(np.broadcast_to(np.asarray(lim.max if lim.max is not None else 0.0, float), x.shape))
     has = np.isfinite(x) & bounds_known
     xv = np.where(has, x, 0.0)
     ok = has & ((lim.min is None) | (xv >= (lim.min if lim.min is not None else 0.0))) & \

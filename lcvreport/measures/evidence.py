@@ -42,6 +42,9 @@ class Evidence:
     verdict: object
     levels: tuple
     model: str = "yaw_plane"
+    #: a ratio measure's (rearward amplification's) signals of its response: (numerator,
+    #: denominator), the reference points the measure was computed between
+    ratio: tuple = ()
 
     def plot(self):
         """The evidence with every level's limit drawn (a :class:`matplotlib.figure.Figure`)."""
@@ -62,24 +65,29 @@ def evidence(assessment, verdict) -> Evidence:
     family = MEASURES[key].family
     speed = kph_to_mps(c.get("speed_kph", 88.0))
     levels = assessment.scheme.levels
-    if verdict.value is None:
-        return Evidence("value", None, verdict, levels)
+    if verdict.value is None and not (family == "yaw_damping" and verdict.lower_bound is not None):
+        return Evidence("value", None, verdict, levels)       # (a heavily damped YDC: its decay is the evidence)
     lane = (c.get("lane_change_ay_g", CONDITIONS["lane_change_ay_g"].default),
             c.get("lane_change_frequency_hz", CONDITIONS["lane_change_frequency_hz"].default))
     f_hz = c.get("ra_frequency_hz", CONDITIONS["ra_frequency_hz"].default)
+    n = v.n_units
     if family == "lane_change" or key in ROLL_LANE_CHANGE:
         from .offtracking import lane_change_measures
         model = "yaw_roll" if key in ROLL_LANE_CHANGE else "yaw_plane"
-        return Evidence("lane_change", lane_change_measures(v, speed, s, *lane, model=model), verdict, levels, model)
+        return Evidence("lane_change", lane_change_measures(v, speed, s, *lane, model=model), verdict, levels, model,
+                        _ratio(key, c, n, (f"ay{n}", "a_steer")))
     if family == "driver_lane_change":
         from .offtracking import driver_lane_change_measures
         K = c.get("driver_gain_rad_per_m", CONDITIONS["driver_gain_rad_per_m"].default)
         T = c.get("driver_preview_s", CONDITIONS["driver_preview_s"].default)
-        return Evidence("lane_change", driver_lane_change_measures(v, speed, s, *lane, K, T), verdict, levels)
+        return Evidence("lane_change", driver_lane_change_measures(v, speed, s, *lane, K, T), verdict, levels,
+                        ratio=_ratio(key, c, n, (f"ay{n}", "a_steer")))
     if family == "single_sine" or key in ROLL_SINGLE_SINE:
         from .amplification import single_sine
         model = "yaw_roll" if key in ROLL_SINGLE_SINE else "yaw_plane"
-        return Evidence("single_sine", single_sine(v, speed, f_hz, tire_scale=s, model=model), verdict, levels, model)
+        plain = (f"r{n}", "r1") if key == "ra_yaw_rate_single_sine" else (f"ay{n}", "ay1")
+        return Evidence("single_sine", single_sine(v, speed, f_hz, tire_scale=s, model=model), verdict, levels, model,
+                        _ratio(key, c, n, plain))
     if family == "yaw_damping":
         from .yaw_damping import yaw_damping_coefficient
         return Evidence("pulse", yaw_damping_coefficient(v, speed, s), verdict, levels)
@@ -98,3 +106,16 @@ def evidence(assessment, verdict) -> Evidence:
         F = residual_force(v, assessment.load_units, src if src else None, s)
         return Evidence("straight_path", straight_path(v, speed, F, s), verdict, levels)
     return Evidence("value", None, verdict, levels)
+
+
+def _ratio(key: str, conditions: dict, n_units: int, plain: tuple) -> tuple:
+    """The (numerator, denominator) signals of a ratio measure: a yaw-roll RA's from its
+    reference points (:data:`lcvreport.measures.roll.RA_POINTS`), the others' ``plain``; () for a
+    measure that is no ratio."""
+    if not key.startswith("ra_"):
+        return ()
+    if key in ("ra_single_sine_roll", "ra_lane_change_roll"):
+        from .roll import RA_POINTS, ra_points
+        num, den = ra_points(conditions.get("ra_numerator"), conditions.get("ra_denominator"), key)
+        return RA_POINTS[num].format(n=n_units), RA_POINTS[den].format(n=n_units)
+    return plain

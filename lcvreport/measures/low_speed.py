@@ -197,6 +197,39 @@ class LowSpeedTurn:
         found = np.isfinite(r_min)
         return mid[found], r_min[found], r_max[found]
 
+    def swing(self, which: str) -> dict:
+        """The path of the corner a swing measure reads, for a close-up of it (what
+        :func:`lcvreport.plotting.low_speed.fig_swing` draws): ``which`` ``"tail"`` -- the rear
+        outer corner of the unit with the largest tail swing, its approach line and where it is
+        farthest beyond it -- or ``"frontal"`` -- unit 1's front outer corner, the outside steer
+        wheel's circle and where the corner is farthest outside it.  Keys: ``unit``, ``points``
+        ((n, 2) [m], world X, Y), ``at`` (the farthest point [m]), ``value_m``, and ``line_y_m``
+        (tail) or ``centre``, ``radius_m`` (frontal); empty when the measure is null."""
+        v, run = self.vehicle, self.run
+        if which == "tail":
+            if not self.tail_swing_m:
+                return {}
+            name = max(self.tail_swing_m, key=self.tail_swing_m.get)
+            k = v.unit_names.index(name)
+            s_at, y0, s_end = self.where["tail_swing"][name]
+            u = v.units[k]
+            s = np.linspace(0.0, max(s_end, 1e-9), 600)
+            pts = run.unit_points(s, k, [u.body_rear_m], [-u.body_width_m / 2])[:, 0]
+            at = run.unit_points(np.array([s_at]), k, [u.body_rear_m], [-u.body_width_m / 2])[0, 0]
+            return {"unit": name, "points": pts, "at": at, "value_m": self.tail_swing_m[name], "line_y_m": y0}
+        if which == "frontal":
+            if self.frontal_swing_m is None:
+                return {}
+            u = v.units[0]
+            s = np.linspace(0.0, run.path.s_end, 1500)
+            pts = run.unit_points(s, 0, [u.body_front_m], [-u.body_width_m / 2])[:, 0]
+            at = run.unit_points(np.array([self.where["frontal_swing_s"]]), 0, [u.body_front_m],
+                                 [-u.body_width_m / 2])[0, 0]
+            return {"unit": u.name, "points": pts, "at": at, "value_m": self.frontal_swing_m,
+                    "centre": np.asarray(run.path.centre, dtype=float), "radius_m": self.radius_m,
+                    "angle_deg": self.angle_deg}
+        raise ValueError(f"which must be tail or frontal, got {which!r}")
+
     def plot(self, title: str | None = None, outlines_every_m: float = 2.0):
         """The swept path seen from above, to scale (:func:`lcvreport.plotting.low_speed.fig_swept_path`)."""
         from ..plotting.low_speed import fig_swept_path
@@ -404,7 +437,7 @@ def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: floa
         undefined["low_speed_offtracking_m"] = never.format(what=f"the centre of axle {steer.name}", angle=angle_deg)
     # tail swing: the rear outer (right) corner beyond its approach line Y = its initial Y, while the
     # unit has turned less than a quarter turn
-    tail = {}
+    tail, tail_at = {}, {}
     quarter = min(angle, math.pi / 2)
     for k_u, u in enumerate(vehicle.units):
         corner = point(k_u, u.body_rear_m, -u.body_width_m / 2)
@@ -416,6 +449,7 @@ def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: floa
         res = _extreme(probe, lambda pts, y0=y0: y0 - pts[..., 1], +1.0, grid, centre, -math.inf,
                        math.inf)                     # no sector: the whole entry, up to the quarter turn
         tail[u.name] = max(0.0, res[0]) if res else 0.0
+        tail_at[u.name] = (float(res[1]) if res else 0.0, y0, float(s_end))
     # frontal swing: unit 1's front outer (right) corner outside the outside wheel's circle
     front = _extreme(_Probe("front outer corner", point(0, u1.body_front_m, -u1.body_width_m / 2), heading(0)),
                      lambda pts: radius(pts) - radius_m, +1.0, s, centre, 0.0, angle)
@@ -425,7 +459,8 @@ def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: floa
     where = {"outermost": best_out[2] if best_out else "", "innermost": best_in[2] if best_in else "",
              "outer_radius_m": best_out[0] if best_out else math.nan,
              "inner_radius_m": best_in[0] if best_in else math.nan,
-             "steer_axle_radius_m": r_steer[0] if r_steer else math.nan}
+             "steer_axle_radius_m": r_steer[0] if r_steer else math.nan,
+             "tail_swing": tail_at, "frontal_swing_s": front[1] if front is not None else math.nan}
     return LowSpeedTurn(vehicle, float(radius_m), float(angle_deg), None if lssp is None else float(lssp),
                         None if offtracking is None else float(offtracking), tail,
                         None if frontal is None else float(frontal), float(length), run, where, undefined)

@@ -25,7 +25,7 @@ from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ
 from ..analysis.steady import Trim
 from ..model.linear import linear_model
-from ..model.vehicle import Vehicle
+from ..model.vehicle import Vehicle, check_vehicle
 from ..model.yaw_plane.loads import load_vector, one_percent_rule
 from ..units import mps_to_kph
 from ..util.threads import one_blas_thread
@@ -136,10 +136,19 @@ class MeasureSet:
         return rows
 
 
+def _load_units(vehicle: Vehicle, load_units) -> tuple:
+    """``load_units`` as a tuple of names; a string (one name, not a list of them) refused in one
+    line naming the units there are (:func:`~lcvreport.model.yaw_plane.loads.check_unit_names`)."""
+    if isinstance(load_units, str):
+        from ..model.yaw_plane.loads import check_unit_names
+        check_unit_names(vehicle, load_units)
+    return tuple(load_units) if load_units else ()
+
+
 def residual_force(vehicle: Vehicle, load_units=None, sources=None, tire_scale: float = 1.0) -> np.ndarray | None:
     """The generalized force [SI] of the 1 % rule on ``load_units`` and of ``sources`` (None if
     neither is given): what the trim is computed against."""
-    units = tuple(load_units) if load_units else ()
+    units = _load_units(vehicle, load_units)
     if not units and not sources:
         return None
     F = np.zeros(linear_model(vehicle).n_states)
@@ -184,7 +193,8 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     >>> round(m.hsso_m, 4) == round(m.values["hsso_m"], 4)
     True
     """
-    units = tuple(load_units) if load_units else ()
+    check_vehicle(vehicle)
+    units = _load_units(vehicle, load_units)
     conditions = check_conditions(conditions)
     case = MeasureCase(vehicle, float(speed_mps), float(tire_scale), float(f_hz),
                        residual_force(vehicle, units, sources, tire_scale), conditions=conditions)
@@ -218,7 +228,8 @@ def measure_values(vehicle: Vehicle, speed_mps: float, keys, tire_scale: float =
     >>> measure_values(v, 24.4, ["hsso_m"])["hsso_m"] == measure_set(v, 24.4).hsso_m
     True
     """
-    units = tuple(load_units) if load_units else ()
+    check_vehicle(vehicle)
+    units = _load_units(vehicle, load_units)
     case = MeasureCase(vehicle, float(speed_mps), float(tire_scale), float(f_hz),
                        residual_force(vehicle, units, sources, tire_scale), conditions=check_conditions(conditions))
     needed = {MEASURES[k].family for k in keys if MEASURES[k].family}

@@ -195,6 +195,9 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
     ------
     ManoeuvreError
         No steered axle.
+    lcvreport.ranges.RangeError
+        A speed, tire scale or radius out of range (the radius: the ranges table's
+        ``steady_turn_radius``, [20, 10000] m).
 
     Examples
     --------
@@ -203,8 +206,10 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
     >>> bool(-1.0 < t.hsso_m < 0.0)                                  # the trailer tracks inside
     True
     """
+    from .registry import CONDITIONS
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
+    radius_m = CONDITIONS["steady_turn_radius_m"].check(radius_m, "radius_m")
     if not vehicle.steered_axles:
         raise ManoeuvreError(f"{vehicle.name} has no steered axle: no steer holds a turn")
     co = system_coefficients(vehicle)
@@ -233,9 +238,10 @@ def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
     axle's largest overshoot beyond the steered axle's final offset (0 if none), and max|a_N| /
     max|a_s|.  NaN where the inverse system is unstable or does not exist, or the steer leaves
     [-1, 1] rad (measure_set's null).  ``lane_change_ay_g`` [g] and ``lane_change_frequency_hz``
-    [Hz]: A0 and F (default :data:`LANE_CHANGE`).  ``extra``: ``(X, XD, D)``, each variant's row of
-    one more signal ``y = X x + XD x' + D delta`` (shapes (B, n), (B, n), (B,)), whose peak |y| is
-    then returned third (the yaw-roll model's load transfer ratio)."""
+    [Hz]: A0 and F (default :data:`LANE_CHANGE`).  ``extra``: a list of triples ``(X, XD, D)``, each
+    variant's row of one more signal ``y = X x + XD x' + D delta`` (shapes (B, n), (B, n), (B,)),
+    whose peaks |y| are then returned after the two (the yaw-roll model's load transfer ratio, its
+    sprung CG's acceleration, a reference point of RA)."""
     from ..analysis.exact import steered_point
     from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
     v = batch.vehicle
@@ -254,20 +260,21 @@ def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
 
     def signals_of(rows):
         def signals(Mz, d_row, ctx):
-            C = np.zeros((Mz.shape[0], 4 + (extra is not None), Mz.shape[-1]))
+            C = np.zeros((Mz.shape[0], 4 + len(extra or ()), Mz.shape[-1]))
             C[:, 0, :n + 2] = y_row                                         # Y of the rear axle
             C[:, 1] = ay_rows(Mz, d_row, ctx)[:, 0]                         # a_N
             C[:, 2] = Mz[:, 0] + xs * Mz[:, 1]                              # a_s = v1' + x_s r1' + u r1
             C[:, 2, 1] += u
             C[:, 3] = d_row                                                 # the steer (within [-1, 1] rad)
-            if extra is not None:                                           # X x + XD x' + D delta
-                X, XD, D = (np.asarray(a)[rows] for a in extra)
-                C[:, 4, :n] = X
-                C[:, 4] += np.einsum("bn,bnd->bd", XD, Mz[:, :n])
-                C[:, 4] += D[:, None] * d_row
+            for k, rows_k in enumerate(extra or ()):                       # X x + XD x' + D delta
+                X, XD, D = (np.asarray(a)[rows] for a in rows_k)
+                C[:, 4 + k, :n] = X
+                C[:, 4 + k] += np.einsum("bn,bnd->bd", XD, Mz[:, :n])
+                C[:, 4 + k] += D[:, None] * d_row
             return C
         return signals
-    hsto, ra, peak_extra = np.full(B, np.nan), np.full(B, np.nan), np.full(B, np.nan)
+    hsto, ra = np.full(B, np.nan), np.full(B, np.nan)
+    peak_extra = np.full((B, len(extra or ())), np.nan)
     for g in range(0, B, RESPONSE_GROUP):
         rows = np.arange(g, min(B, g + RESPONSE_GROUP))
         ok = batch.inverse_stable(u, tire_scale, rows)
@@ -280,9 +287,8 @@ def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
         steer_ok = peak[:, 3] <= RANGES["steer_angle"].high                # else refused (measure_set's null)
         hsto[rows[steer_ok]] = np.maximum(0.0, over[steer_ok])
         ra[rows[steer_ok]] = peak[steer_ok, 1] / peak[steer_ok, 2]
-        if extra is not None:
-            peak_extra[rows[steer_ok]] = peak[steer_ok, 4]
-    return (hsto, ra) if extra is None else (hsto, ra, peak_extra)
+        peak_extra[rows[steer_ok]] = peak[steer_ok, 4:]
+    return (hsto, ra) if extra is None else (hsto, ra, *peak_extra.T)
 
 
 def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0,

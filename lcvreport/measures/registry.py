@@ -49,6 +49,9 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:                                # annotations only: the registry imports no model
     from ..model.vehicle import Vehicle
 
+#: why a family whose equations are singular for the vehicle is null
+NO_STEADY_STATE = ("undefined: its equations have no solution for this vehicle (singular: a unit whose tires cannot "
+                   "hold both its lateral force and its yaw moment, such as a rigid unit on one axle)")
 #: why a measure that needs a steer input is null on a vehicle without a steered axle
 NO_STEER = "undefined: the vehicle has no steered axle, so no steer input to respond to or trim with"
 
@@ -71,15 +74,19 @@ class MeasureCase:
     #: its default (``ra_frequency_hz`` is ``f_hz``)
     conditions: dict = field(default_factory=dict)
 
-    def condition(self, key: str) -> float:
-        """The value of the condition ``key`` in its unit (:data:`CONDITIONS`)."""
+    def condition(self, key: str, measure: str | None = None):
+        """The value of the condition ``key`` in its unit (:data:`CONDITIONS`); a choice (an RA
+        reference point) as its name; not given: ``measure``'s default where the registry gives
+        the measure one, else the condition's."""
         if key == "ra_frequency_hz":
             return self.f_hz
         if key == "speed_kph":
             from ..units import mps_to_kph
             return mps_to_kph(self.speed_mps)
         value = self.conditions.get(key)
-        return CONDITIONS[key].default if value is None else float(value)
+        if value is None:
+            return default_condition(key, measure)
+        return value if CONDITIONS[key].choices else float(value)
 
 
 def _resolve(ref: str):
@@ -117,24 +124,32 @@ class Family:
         return self.needs != "sources" or case.F is not None
 
     def compute(self, case: MeasureCase) -> tuple[dict, dict]:
-        """({key: value or None}, {key: why it is null}) of one vehicle."""
+        """({key: value or None}, {key: why it is null}) of one vehicle; a family whose equations
+        have no solution for this vehicle (a singular steady state) is null with that reason."""
+        import numpy as np
         if self.needs in ("steer", "sources") and not case.vehicle.steered_axles:
             if self.needs == "sources":
                 return {k: None for k in self.keys}, {"trim": NO_STEER}
             return {k: None for k in self.keys}, {k: NO_STEER for k in self.keys}
-        return _resolve(self.scalar)(case)
+        try:
+            return _resolve(self.scalar)(case)
+        except np.linalg.LinAlgError:
+            why = NO_STEADY_STATE
+            return {k: None for k in self.keys}, ({"trim": why} if self.needs == "sources" else
+                                                  {k: why for k in self.keys})
 
     def compute_batched(self, batch, case: MeasureCase) -> tuple:
         """One array (B,) per key of :attr:`batched_keys`, NaN where undefined."""
         fn = _resolve(self.batched)
         names = inspect.signature(fn).parameters
         kwargs = {k: getattr(case, k) for k in ("speed_mps", "tire_scale", "f_hz", "F") if k in names}
-        kwargs.update({k: case.condition(k) for k in self.conditions if k in names})
+        kwargs.update({k: case.condition(k) for k in self.conditions if k in names and not CONDITIONS[k].choices})
+        kwargs.update({k: case.conditions.get(k) for k in self.conditions if k in names and CONDITIONS[k].choices})
         out = fn(batch, **kwargs)
         return out if isinstance(out, tuple) else (out,)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Measure:
     """One measure (see the module docstring for the fields)."""
 
@@ -148,6 +163,18 @@ class Measure:
     shape: str = "scalar"
     #: the conditions it depends on, where fewer than its family's (None: the family's)
     own_conditions: tuple | None = None
+    #: the name the performance-based standards give it ("" where they give none)
+    standard: str = ""
+    #: the defaults of conditions where the measure's differs from the condition's
+    defaults: dict = field(default_factory=dict)
+    #: what the toolkit's number leaves out of the standard's measure ("" for nothing): printed
+    #: wherever it is judged (TASP: the steady part only)
+    caveat: str = ""
+
+    @property
+    def title(self) -> str:
+        """The measure as a verdict page names it: the standard's words, else the label."""
+        return self.standard or self.label[:1].upper() + self.label[1:]
 
     @property
     def model(self) -> str:
@@ -188,28 +215,53 @@ class Condition:
     unit: str
     range: str
     definition: str
-    default: float | None = None
+    default: float | str | None = None
     #: the short name of a verdict table ("A0 0.15 g"; empty: the value and unit alone)
     short: str = ""
+    #: the values of a condition that is a choice (an RA reference point), not a number
+    choices: tuple = ()
 
     @property
     def option(self) -> str:
         """The ``lcv measures`` option that sets it."""
         return "--" + self.key.replace("_", "-")
 
-    def check(self, value, name: str | None = None) -> float:
-        """``value`` as a float, or :class:`lcvreport.ranges.RangeError` naming ``name``."""
-        from ..ranges import RANGES
+    def check(self, value, name: str | None = None):
+        """``value`` as a float (a choice: as its name), or :class:`lcvreport.ranges.RangeError`
+        naming ``name``."""
+        from ..ranges import RANGES, RangeError
         from ..units import MPS_PER_KPH
+        if self.choices:
+            if not isinstance(value, str) or value not in self.choices:
+                shown = repr(value) if len(repr(value)) <= 60 else repr(value)[:57] + "..."
+                raise RangeError(name or self.key, f"{name or self.key} must be one of {', '.join(self.choices)}, "
+                                                   f"got {shown}")
+            return value
         factor = 1.0 / MPS_PER_KPH if self.key == "speed_kph" else 1.0
         return RANGES[self.range].check(value, name or self.key, factor=factor, unit=self.unit)
+
+
+def default_condition(key: str, measure: str | None = None):
+    """The value the condition ``key`` takes when not given: ``measure``'s own default where the
+    registry gives one (the RA measures' reference points), else the condition's.
+
+    Examples
+    --------
+    >>> default_condition("ra_denominator", "ra_single_sine_roll"), default_condition("ra_denominator",
+    ...                                                                            "ra_lane_change_roll")
+    ('cg', 'steer_axle')
+    """
+    if measure is not None and key in MEASURES[measure].defaults:
+        return MEASURES[measure].defaults[key]
+    return CONDITIONS[key].default
 
 
 def _load(text: str) -> tuple[dict, dict, dict]:
     """(CONDITIONS, FAMILIES, MEASURES) from the registry's data file."""
     import tomllib
     doc = tomllib.loads(text)
-    conditions = {key: Condition(key, **entry) for key, entry in doc["conditions"].items()}
+    conditions = {key: Condition(key, **{k: tuple(v) if k == "choices" else v for k, v in entry.items()})
+                  for key, entry in doc["conditions"].items()}
     families = {name: Family(name, **{k: tuple(v) if k == "conditions" else v for k, v in entry.items()})
                 for name, entry in doc["families"].items()}
     measures = {m["key"]: Measure(**{k: v for k, v in m.items() if k != "conditions"},
@@ -227,9 +279,26 @@ CONDITIONS, FAMILIES, MEASURES = _load(resources.files(__package__.partition("."
 CRITERIA_KEYS = tuple(k for k, m in MEASURES.items() if m.shape == "scalar" and m.family is not None)
 #: the batched families and the keys each gives, in order (studies compute these over cases)
 BATCHED = {name: f.batched_keys for name, f in FAMILIES.items() if f.batched}
-#: spellings of other versions and names that are not measures: the key to use instead
-ALIASES = {"trim_delta_rad": "trim.delta_rad", "trim_offtracking_m": "trim.offtracking_m",
-           "tail_swing_m": "max_tail_swing_m"}
+#: keys of earlier releases: the key they are now (read as it, :func:`canonical`)
+RENAMED = {"trim_delta_rad": "trim.delta_rad", "trim_offtracking_m": "trim.offtracking_m"}
+#: names that are not measures but look like one: the key meant (a hint, not read as it --
+#: ``tail_swing_m`` is ``lcv turn``'s per-unit table)
+HINTS = {"tail_swing_m": "max_tail_swing_m"}
+#: both, for the messages
+ALIASES = {**RENAMED, **HINTS}
+
+
+def canonical(key: str) -> str:
+    """The registry's key of ``key``: a key of an earlier release (``trim_delta_rad``) is an alias
+    of today's (``trim.delta_rad``), read wherever a key is (criteria, schemes, studies); any other
+    key as it is (an unknown one is refused by its reader).
+
+    Examples
+    --------
+    >>> canonical("trim_delta_rad"), canonical("hsso_m")
+    ('trim.delta_rad', 'hsso_m')
+    """
+    return RENAMED.get(key, key) if isinstance(key, str) else key
 
 
 def unknown_key_message(key: str, valid=CRITERIA_KEYS) -> str:

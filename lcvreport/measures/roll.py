@@ -53,13 +53,39 @@ def ltr_peaks(response, n_groups: int) -> list[float]:
     return [float(x) for x in response.peaks_abs([f"ltr{g + 1}" for g in range(n_groups)])]
 
 
-def ltr_single_sine(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, f_hz: float = LANE_CHANGE[1]):
-    """(RA, |LTR| peaks per group) of the 0.4 Hz single sine on the yaw-roll model, the LTR scaled
-    to ``max|a_1| = 0.15 g`` (the model is linear)."""
+#: the signal of each RA reference point in a yaw-roll response (docs/measures.md#roll-measures):
+#: the rearmost unit's sprung CG ``as<N>`` or roll-axis point ``ay<N>``; the hauling unit's
+#: steered axle ``a_steer`` or CG ``ay1``
+RA_POINTS = {"sprung_cg": "as{n}", "roll_axis": "ay{n}", "steer_axle": "a_steer", "cg": "ay1"}
+
+
+def ra_points(numerator: str | None, denominator: str | None, measure: str) -> tuple[str, str]:
+    """(numerator, denominator) of an RA measure: the points given, each missing one at the
+    measure's default (:func:`~lcvreport.measures.registry.default_condition`)."""
+    from .registry import default_condition
+    return (numerator or default_condition("ra_numerator", measure),
+            denominator or default_condition("ra_denominator", measure))
+
+
+def rearward_amplification(response, n_units: int, numerator: str, denominator: str) -> float:
+    """max|numerator| / max|denominator| over a yaw-roll ``response`` (the points' signals
+    located on the continuous response: :data:`RA_POINTS`)."""
+    top, bottom = (RA_POINTS[p].format(n=n_units) for p in (numerator, denominator))
+    peaks = response.peaks_abs([top, bottom])
+    return float(peaks[0] / peaks[1])
+
+
+def ltr_single_sine(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, f_hz: float = LANE_CHANGE[1],
+                    numerator: str | None = None, denominator: str | None = None):
+    """(RA, |LTR| peaks per group) of the 0.4 Hz single sine on the yaw-roll model, the RA between
+    the points given (default the measure's: the rearmost unit's sprung CG over unit 1's CG), the
+    LTR scaled to ``max|a_1| = 0.15 g`` (the model is linear)."""
     s = single_sine(vehicle, speed_mps, f_hz, tire_scale=tire_scale, model=MODEL)
     scale = LTR_SINGLE_SINE_G * G_MPS2 / float(s.peaks[0])
     groups = len(linear_model(vehicle, MODEL).roll.groups)
-    return s.rearward_amplification, [scale * x for x in ltr_peaks(s.response, groups)]
+    points = ra_points(numerator, denominator, "ra_single_sine_roll")
+    return (rearward_amplification(s.response, vehicle.n_units, *points),
+            [scale * x for x in ltr_peaks(s.response, groups)])
 
 
 @dataclass(frozen=True)
@@ -110,10 +136,29 @@ def roll_summary(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) ->
                        values["roll_critical_speed_kph"], reasons)
 
 
+#: the roll measures read from a manoeuvre or a steady turn: undefined when the roll mode is
+#: unstable at rest (the response grows without bound from any start)
+RESPONSE_KEYS = ("ra_single_sine_roll", "ltr_single_sine", "ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change",
+                 "rltr_lane_change", "roll_gain_deg_per_g")
+
+
+def unstable_at_rest(vehicle: Vehicle) -> str | None:
+    """Why the roll responses of ``vehicle`` are undefined -- a roll-coupled group whose roll
+    stiffness cannot hold its sprung weight (its stiffness matrix at rest is not positive
+    definite: SRT 0, a roll mode unstable at any speed) -- or None."""
+    weak = [", ".join(g.units) for g in rollover_threshold(vehicle).groups if not g.stable_at_rest]
+    if not weak:
+        return None
+    return (f"undefined: the roll mode is unstable at rest ({'; '.join(weak)}: the roll stiffness cannot hold the "
+            "sprung weight, SRT 0): every response grows without bound")
+
+
 def _dynamic(vehicle: Vehicle, u: float, s: float, f_hz: float = LANE_CHANGE[1],
-             lane_change: tuple[float, float] = LANE_CHANGE) -> tuple[dict, dict]:
+             lane_change: tuple[float, float] = LANE_CHANGE, numerator: str | None = None,
+             denominator: str | None = None) -> tuple[dict, dict]:
     """The roll family's values and reasons (roll data present): the single sine at ``f_hz``
-    [Hz], the lane change of ``lane_change`` (A0 [g], F [Hz])."""
+    [Hz], the lane change of ``lane_change`` (A0 [g], F [Hz]), the RA between ``numerator`` and
+    ``denominator`` (:data:`RA_POINTS`; None: each RA measure's default)."""
     values, reasons = dict.fromkeys(ROLL_KEYS), {}
     zeta, _f = least_damping(vehicle, u, s, model=MODEL)
     values["roll_least_damping_ratio"] = zeta
@@ -123,12 +168,17 @@ def _dynamic(vehicle: Vehicle, u: float, s: float, f_hz: float = LANE_CHANGE[1],
     values["roll_critical_speed_kph"] = crit
     if crit is None:
         reasons["roll_critical_speed_kph"] = f"stable at every speed up to {CRITICAL_SPEED_MAX_KPH:g} km/h"
+    unstable = unstable_at_rest(vehicle)
+    if unstable is not None:
+        reasons.update(dict.fromkeys(RESPONSE_KEYS, unstable))
+        return values, reasons
     if not vehicle.steered_axles:
         for k in ("ra_single_sine_roll", "ltr_single_sine", "ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change",
                   "rltr_lane_change", "roll_gain_deg_per_g"):
             reasons[k] = NO_STEER
         return values, reasons
-    values["ra_single_sine_roll"], values["ltr_single_sine"] = ltr_single_sine(vehicle, u, s, f_hz)
+    values["ra_single_sine_roll"], values["ltr_single_sine"] = ltr_single_sine(vehicle, u, s, f_hz, numerator,
+                                                                              denominator)
     groups = len(linear_model(vehicle, MODEL).roll.groups)
     try:
         lc = lane_change_measures(vehicle, u, s, *lane_change, model=MODEL)
@@ -136,7 +186,9 @@ def _dynamic(vehicle: Vehicle, u: float, s: float, f_hz: float = LANE_CHANGE[1],
         for k in ("ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change", "rltr_lane_change"):
             reasons[k] = f"undefined: {exc}"
     else:
-        values["ra_lane_change_roll"], values["hsto_m_roll"] = lc.ra_lane_change, lc.hsto_m
+        points = ra_points(numerator, denominator, "ra_lane_change_roll")
+        values["ra_lane_change_roll"] = rearward_amplification(lc.response, vehicle.n_units, *points)
+        values["hsto_m_roll"] = lc.hsto_m
         values["ltr_lane_change"] = ltr_peaks(lc.response, groups)
         values["rltr_lane_change"] = values["ltr_lane_change"][-1]
     gains = roll_gains(vehicle, u, s)
@@ -147,7 +199,8 @@ def _dynamic(vehicle: Vehicle, u: float, s: float, f_hz: float = LANE_CHANGE[1],
 
 
 def roll_batched(batch, speed_mps: float, tire_scale: float = 1.0, f_hz: float = LANE_CHANGE[1],
-                 lane_change_ay_g: float = LANE_CHANGE[0], lane_change_frequency_hz: float = LANE_CHANGE[1]) -> tuple:
+                 lane_change_ay_g: float = LANE_CHANGE[0], lane_change_frequency_hz: float = LANE_CHANGE[1],
+                 ra_numerator: str | None = None, ra_denominator: str | None = None) -> tuple:
     """The roll family's scalar measures over the variants of ``batch`` (any model: its variants
     are taken to the yaw-roll model, each one's coefficients built exactly), one array each in the
     registry's order: ``roll_least_damping_ratio``, ``roll_critical_speed_kph``,
@@ -167,7 +220,7 @@ def roll_batched(batch, speed_mps: float, tire_scale: float = 1.0, f_hz: float =
     >>> bool(abs(rltr[1] - roll_summary(v, 25.0).ltr_lane_change[-1]) < 1e-12)
     True
     """
-    from .amplification import single_sine_batched
+    from .amplification import single_sine_peaks
     from .offtracking import lane_change_batched
     from .stability import critical_speed_batched, least_damping_batched
     if missing_roll_data(batch.vehicle) is not None:
@@ -179,16 +232,38 @@ def roll_batched(batch, speed_mps: float, tire_scale: float = 1.0, f_hz: float =
     nan = np.full(rb.size, np.nan)
     if not rb.vehicle.steered_axles:
         return zeta, crit, nan, nan, nan, nan.copy()
-    ra_ss = single_sine_batched(rb, u, f_hz, s)[0]
-    last = f"ltr{len(linear_model(rb.vehicle, MODEL).roll.groups)}"
-    rows = []
-    for v in rb.vehicles():                               # each variant's own load transfer row
+    unstable = np.array([unstable_at_rest(v) is not None for v in rb.vehicles()])
+    co = linear_model(rb.vehicle, MODEL)
+    nu = rb.vehicle.n_units
+    last = f"ltr{len(co.roll.groups)}"
+    ltr_rows, as_rows = [], []
+    for v in rb.vehicles():                               # each variant's own rows
         names, X, XD, D, _O = linear_model(v, MODEL).extra_signals(u, s)
-        k = names.index(last)
-        rows.append((X[k], XD[k], D[k]))
-    extra = tuple(np.array([r[i] for r in rows]) for i in range(3))
-    hsto, ra_lc, rltr = lane_change_batched(rb, u, s, lane_change_ay_g, lane_change_frequency_hz, extra=extra)
-    return zeta, crit, ra_ss, ra_lc, hsto, rltr
+        for rows, name in ((ltr_rows, last), (as_rows, f"as{nu}")):
+            k = names.index(name)
+            rows.append((X[k], XD[k], D[k]))
+    stack = lambda rows: tuple(np.array([r[i] for r in rows]) for i in range(3))   # noqa: E731
+    # the other points, the same rows for every variant (the batch shares one geometry): the
+    # rearmost unit's roll-axis point a_N = v_N' + u r_N, unit 1's CG a_1 = v1' + u r1 and the
+    # steered axle's a_s = v1' + x_s r1' + u r1
+    from ..analysis.exact import steered_point
+    V, R = co.velocity_map(u), co.yaw_rate_map()
+    a_n = (u * R[nu - 1], V[nu - 1], 0.0)
+    a_1 = (u * R[0], V[0], 0.0)
+    a_s = (u * R[0], V[0] + steered_point(rb.vehicle) * R[0], 0.0)
+    same = lambda row: tuple(np.broadcast_to(np.asarray(a, dtype=float), (rb.size,) + np.shape(a)) for a in row)  # noqa: E731
+    points = [stack(as_rows), same(a_n), same(a_1), same(a_s)]
+    names = ("sprung_cg", "roll_axis", "cg", "steer_axle")
+    num_ss, den_ss = ra_points(ra_numerator, ra_denominator, "ra_single_sine_roll")
+    num_lc, den_lc = ra_points(ra_numerator, ra_denominator, "ra_lane_change_roll")
+    ss = dict(zip(names, single_sine_peaks(rb, u, f_hz, s, extra=points)[:, 4:].T))
+    ra_ss = ss[num_ss] / ss[den_ss]
+    hsto, _ra, rltr, *peaks = lane_change_batched(rb, u, s, lane_change_ay_g, lane_change_frequency_hz,
+                                                  extra=[stack(ltr_rows), *points])
+    lc = dict(zip(names, peaks))
+    ra_lc = lc[num_lc] / lc[den_lc]
+    responses = [np.where(unstable, np.nan, a) for a in (ra_ss, ra_lc, hsto, rltr)]   # as roll_family: undefined
+    return (zeta, crit, *responses)
 
 
 def rollover_batched(batch) -> tuple:
@@ -214,7 +289,8 @@ def roll_family(case: MeasureCase) -> tuple[dict, dict]:
     if missing is not None:
         return missing
     return _dynamic(case.vehicle, case.speed_mps, case.tire_scale, case.f_hz,
-                    (case.condition("lane_change_ay_g"), case.condition("lane_change_frequency_hz")))
+                    (case.condition("lane_change_ay_g"), case.condition("lane_change_frequency_hz")),
+                    case.conditions.get("ra_numerator"), case.conditions.get("ra_denominator"))
 
 
 def rollover_family(case: MeasureCase) -> tuple[dict, dict]:

@@ -44,8 +44,9 @@ from pathlib import Path
 
 from ..ranges import RangeError
 from ..util.files import FileInputError, loads_toml, read_toml_file
+from ..util.text import control_character, listed, named, shown
 from .criteria import CriteriaError, Limit, Relative, _relative
-from .registry import CONDITIONS, CRITERIA_KEYS, MEASURES, unknown_key_message
+from .registry import CONDITIONS, CRITERIA_KEYS, MEASURES, canonical, default_condition, unknown_key_message
 
 #: the keys of a scheme file's top level
 TOP_KEYS = ("scheme", "levels", "description", "status", "measures")
@@ -55,6 +56,17 @@ STATUSES = ("template", "draft", "published", "user")
 
 class SchemeError(ValueError):
     """A scheme file that cannot be used; the message is one line naming the key."""
+
+
+def _check_text(where: str, text: str, allow: str = "") -> str:
+    """``text`` unless it holds a character a scheme's text may not (a control character -- a
+    newline in a level name would forge a line of the verdict table, an ESC a terminal command,
+    U+0000 stops xelatex -- a bidirectional override); ``allow``: the line breaks of a free
+    description."""
+    bad = control_character(text, allow)
+    if bad is not None:
+        raise SchemeError(f"{where}: text only, got the control character U+{ord(bad):04X} in {shown(text)}")
+    return text
 
 
 @dataclass(frozen=True)
@@ -129,26 +141,34 @@ def loads_scheme(text: str) -> Scheme:
 def _scheme(doc: dict, path: str) -> Scheme:
     unknown = [k for k in doc if k not in TOP_KEYS]
     if unknown:
-        raise SchemeError(f"{unknown[0]}: not a key of a scheme file (keys: {', '.join(TOP_KEYS)})")
+        raise SchemeError(f"{named(unknown[0])}: not a key of a scheme file (keys: {', '.join(TOP_KEYS)})")
     name = doc.get("scheme")
     if not isinstance(name, str) or not name.strip():
         raise SchemeError("scheme: name the scheme (a string: the document, its edition, or 'template')")
+    _check_text("scheme", name)
     levels = doc.get("levels")
     if not isinstance(levels, list) or not levels or not all(isinstance(x, str) and x.strip() for x in levels):
         raise SchemeError("levels: a list of level names, most demanding first (e.g. [\"L1\", \"L2\"])")
+    for k, level in enumerate(levels):
+        _check_text(f"levels[{k}]", level)
     if len(set(levels)) != len(levels):
         twice = next(x for x in levels if levels.count(x) > 1)
-        raise SchemeError(f"levels: {twice!r} is named twice")
+        raise SchemeError(f"levels: {shown(twice)} is named twice")
     status = doc.get("status", "user")
     if status not in STATUSES:
         raise SchemeError(f"status: one of {', '.join(STATUSES)}, got {status!r}")
     description = doc.get("description", "")
     if not isinstance(description, str):
         raise SchemeError("description: a string")
+    _check_text("description", description, allow="\n\t")
     entries = doc.get("measures")
     if not isinstance(entries, dict) or not entries:
         raise SchemeError("measures: give at least one [measures.<key>] table")
-    measures = tuple(_measure(key, entry, levels) for key, entry in entries.items())
+    measures = tuple(_measure(canonical(key), entry, levels) for key, entry in entries.items())
+    keys = [m.key for m in measures]
+    twice = next((k for k in keys if keys.count(k) > 1), None)
+    if twice is not None:
+        raise SchemeError(f"measures.{twice}: named twice (once by an alias of an earlier release)")
     known = {m.key: m for m in measures}
     for m in measures:
         for ref in m.references:
@@ -180,33 +200,36 @@ def _measure(key: str, entry, levels: list) -> SchemeMeasure:
         if name not in allowed:
             what = (f"{key} depends on {', '.join(allowed)}" if allowed else f"{key} depends on no condition")
             kind = "a condition of another measure" if name in CONDITIONS else "not a key of a measure's table"
-            raise SchemeError(f"{where}.{name}: {kind}; {what} (and source, levels)")
+            raise SchemeError(f"{where}.{named(name)}: {kind}; {what} (and source, levels)")
         try:
             conditions[name] = CONDITIONS[name].check(value, f"{where}.{name}")
         except RangeError as exc:
             raise SchemeError(str(exc)) from None
     for name in allowed:
         if name not in conditions:
-            default = CONDITIONS[name].default
+            default = default_condition(name, key)
             if default is None:
                 raise SchemeError(f"{where}.{name}: give the {CONDITIONS[name].label} [{CONDITIONS[name].unit}] "
                                   f"{key} is taken at")
-            conditions[name] = float(default)
+            conditions[name] = default if CONDITIONS[name].choices else float(default)
     conditions = {c: conditions[c] for c in allowed}
     source = entry.get("source")
     if source is not None and (not isinstance(source, str) or not source.strip()):
         raise SchemeError(f"{where}.source: a string naming the document, its edition and clause")
+    if source is not None:
+        _check_text(f"{where}.source", source)
     table = entry.get("levels")
     if not isinstance(table, dict) or not table:
-        raise SchemeError(f"{where}.levels: give one limit per level ({', '.join(levels)})")
+        raise SchemeError(f"{where}.levels: give one limit per level ({listed(levels, what='levels')})")
     for name in table:
         if name not in levels:
-            raise SchemeError(f"{where}.levels.{name}: not a level of the scheme (levels: {', '.join(levels)})")
+            raise SchemeError(f"{where}.levels.{named(name)}: not a level of the scheme (levels: "
+                              f"{listed([named(x) for x in levels], what='levels')})")
     limits = {}
     for level in levels:
         if level not in table:
             raise SchemeError(f"{where}.levels: no limit for level {level!r}; give one for every level "
-                              f"({', '.join(levels)})")
+                              f"({listed(levels, what='levels')})")
         limits[level] = _limit(key, f"{where}.levels.{level}", table[level], source)
     return SchemeMeasure(key, conditions, limits)
 
@@ -241,6 +264,7 @@ def _limit(key: str, where: str, spec, source: str | None) -> Limit:
     if not isinstance(src, str) or not src.strip():
         raise SchemeError(f"{where}.source: name the document the limit comes from (here or in the measure's "
                           f"table)")
+    _check_text(f"{where}.source", src)
     absolute = spec.get("abs", False)
     if not isinstance(absolute, bool):
         raise SchemeError(f"{where}.abs: true or false, got {absolute!r}")

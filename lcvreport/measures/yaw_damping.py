@@ -82,6 +82,8 @@ class YawDamping:
     response: ManoeuvreResponse
     why: str = ""
     lower_bound: float | None = None
+    #: what a heavily damped joint's zeta is at least (:data:`YDC_HEAVY_ZETA`)
+    heavy_zeta: float = YDC_HEAVY_ZETA
 
 
 def ratio_damping(extrema_values) -> tuple[float | None, np.ndarray]:

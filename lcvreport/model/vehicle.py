@@ -287,11 +287,37 @@ class Unit:
                                f"{k / reach:.2g} of the {reach:.3g} m from its CG to its farthest axle or coupling; "
                                f"below {GYRATION_PER_REACH_MIN:g} the model's eigenvalues are not reliable (a real "
                                "body's is 0.05-2 of its length): the inertia or the mass is in another unit")
+        ixz = self.yaw_roll_product_kg_m2
+        if ixz is not None and self.roll_inertia_kg_m2 is not None and ixz * ixz >= \
+                self.roll_inertia_kg_m2 * self.yaw_inertia_kg_m2:
+            raise VehicleError("yaw_roll_product_kg_m2", f"yaw_roll_product_kg_m2 {ixz:.6g} kg*m^2 with "
+                               f"roll_inertia_kg_m2 {self.roll_inertia_kg_m2:.6g} and yaw_inertia_kg_m2 "
+                               f"{self.yaw_inertia_kg_m2:.6g} is no body's: I_xz^2 must be below I_x I_z (the "
+                               "inertia matrix is positive definite)")
 
     @property
     def rearmost_axle(self) -> Axle:
         """The axle with the smallest (most rearward) x."""
         return min(self.axles, key=lambda a: a.x_m)
+
+
+def check_vehicle(vehicle, name: str = "vehicle") -> "Vehicle":
+    """``vehicle`` if it is a :class:`Vehicle`, else one :class:`TypeError` line saying how to
+    get one (a preset's name or a file's path is not one).
+
+    Examples
+    --------
+    >>> check_vehicle("aucnat")
+    Traceback (most recent call last):
+    ...
+    TypeError: vehicle must be a Vehicle (lcvreport.load_preset("aucnat") or lcvreport.load_vehicle(path)), got the str 'aucnat'
+    """
+    if isinstance(vehicle, Vehicle):
+        return vehicle
+    shown = repr(vehicle)
+    shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    raise TypeError(f'{name} must be a Vehicle (lcvreport.load_preset("aucnat") or lcvreport.load_vehicle(path)), '
+                    f"got the {type(vehicle).__name__} {shown}")
 
 
 @dataclass(frozen=True)

@@ -202,13 +202,13 @@ def loads_vehicle(text: str, source: str = "") -> Vehicle:
 
 def _check_key_lengths(text: str) -> None:
     """Refuse dotted keys of more than :data:`MAX_DEPTH` parts before parsing (tomllib takes
-    time quadratic in the parts: a 40,000-part key would hang it)."""
-    for number, line in enumerate(text.splitlines(), 1):
-        stripped = line.lstrip()
-        key = stripped.split("]", 1)[0] if stripped.startswith("[") else stripped.split("=", 1)[0]
-        if key.count(".") >= MAX_DEPTH:
-            raise VehicleFileError("", f"line {number}: a key of {key.count('.') + 1} dotted parts; a vehicle file "
-                                       f"needs at most 3")
+    time quadratic in the parts: a 40,000-part key would hang it); periods in comments and
+    strings are not keys' (a comment listing loads in tonnes is a comment)."""
+    from ..util.files import check_key_parts
+    found = check_key_parts(text, MAX_DEPTH)
+    if found is not None:
+        raise VehicleFileError("", f"line {found[0]}: a key of {found[1]} dotted parts; a vehicle file needs at "
+                                   "most 3")
 
 
 def read_vehicle_text(path: str | Path) -> str:

@@ -6,16 +6,14 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from .style import PAGE_WIDTH_IN, PALETTE, SMALL_PT, new_figure
+from .style import LEVEL_STYLES, PAGE_WIDTH_IN, PALETTE, SMALL_PT, new_figure, plain
 
-#: the line styles of the levels' limits, most demanding first
-LEVEL_STYLES = ("--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (1, 1)))
 
 
 def _title(ev) -> str:
     m = ev.verdict
     value = "none" if m.value is None else f"{m.value:.4g} {m.unit}"
-    return f"{m.key} = {value} ({m.conditions_text()}); reaches {m.level_reached or 'no level'}"
+    return plain(f"{m.key} = {value} ({m.conditions_text()}); reaches {m.level_reached or 'no level'}")
 
 
 def _limits(ev) -> list[tuple[str, float, str]]:
@@ -27,7 +25,7 @@ def _limits(ev) -> list[tuple[str, float, str]]:
         for kind, b in (("min", lo), ("max", hi)):
             if b is not None:
                 seen.setdefault((kind, b), []).append(level)
-    return [("/".join(levels), b, kind) for (kind, b), levels in seen.items()]
+    return [(plain("/".join(levels)), b, kind) for (kind, b), levels in seen.items()]
 
 
 def _hlines(ax, ev, scale: float = 1.0, offset: float = 0.0, symmetric: bool = False, what: str = "limit") -> None:
@@ -43,6 +41,12 @@ def _legend(ax) -> None:
     ax.legend(fontsize=SMALL_PT, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, frameon=False)
 
 
+def _beside(ax, handles=None) -> None:
+    """The legend right of the axes: over no curve and no limit line."""
+    kw = {} if handles is None else {"handles": handles}
+    ax.legend(fontsize=SMALL_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False, **kw)
+
+
 def fig_evidence(ev) -> Figure:
     """One measure's evidence with its limits (see the module docstring)."""
     key = ev.verdict.key
@@ -56,10 +60,15 @@ def fig_evidence(ev) -> Figure:
         fig = fig_pulse(ev.result, names, _title(ev))
         _text_box(fig.axes[0], ev)
         return fig
+    if ev.kind == "swept_path" and key in ("max_tail_swing_m", "frontal_swing_m"):
+        from .low_speed import fig_swing
+        which = "tail" if key == "max_tail_swing_m" else "frontal"
+        limits = [(levels, b) for levels, b, _kind in _limits(ev)]
+        return fig_swing(ev.result.swing(which), which, _title(ev), limits)
     if ev.kind == "swept_path":
         from .low_speed import fig_swept_path
         fig = fig_swept_path(ev.result, _title(ev))
-        _text_box(fig.axes[0], ev, x=0.55)                  # the drawing's legend holds the upper left
+        _text_box(fig.axes[0], ev)
         return fig
     if ev.kind == "tilt":
         from .roll import plot_rollover
@@ -68,16 +77,20 @@ def fig_evidence(ev) -> Figure:
         _hlines(ax, ev, what="limit on the SRT")
         ax.set_title(_title(ev), fontsize=SMALL_PT + 1)
         handles = [h for h in ax.get_lines() if not h.get_label().startswith("_") and "lift-offs" not in h.get_label()]
-        ax.legend(handles=handles, fontsize=SMALL_PT, loc="lower right")
+        ax.legend(handles=handles, fontsize=SMALL_PT, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2,
+                  frameon=False)
         return fig
     return _value(ev)
 
 
-def _text_box(ax, ev, x: float = 0.01) -> None:
-    """The limits and verdicts of every level in a box at the top of ``ax`` (from ``x``, axes fraction)."""
-    lines = [f"{level}: {ev.verdict.limits[level]}: {ev.verdict.verdicts[level]}" for level in ev.levels]
-    ax.text(x, 0.99, "\n".join(lines), transform=ax.transAxes, fontsize=SMALL_PT, va="top", ha="left",
-            bbox={"facecolor": "white", "edgecolor": "gray", "lw": 0.5, "alpha": 0.9}, zorder=10)
+def _text_box(ax, ev) -> None:
+    """The limit and the verdict of every level as the title's second line (over no data, and no
+    legend over it)."""
+    m = ev.verdict
+    limits = "; ".join(f"{level} {m.limit_texts.get(level, m.limits[level])}: {m.verdicts[level]}"
+                       for level in ev.levels)
+    import textwrap
+    ax.set_title("\n".join([_title(ev), *textwrap.wrap(plain(limits), 90)]), fontsize=SMALL_PT + 1)
 
 
 def _lane_change(ev, key: str) -> Figure:
@@ -89,21 +102,64 @@ def _lane_change(ev, key: str) -> Figure:
         groups = len(linear_model(lc.response.vehicle, "yaw_roll").roll.groups)
         fig = plot_ltr(lc.response, groups, _title(ev))
         _hlines(fig.axes[0], ev, symmetric=True, what="limit on |LTR| of the rearmost group")
-        fig.axes[0].legend(fontsize=SMALL_PT, loc="lower right")
+        _beside(fig.axes[0])
         return fig
+    if ev.ratio:                                   # a rearward amplification: its two points
+        return _ratio(ev, lc.response)
     fig = fig_lane_change(lc, _title(ev))
-    if key.startswith("hsto"):                     # hsto_m, hsto_m_roll, hsto_driver_m
-        sign = 1.0 if lc.final_offset_m >= 0 else -1.0
-        _hlines(fig.axes[1], ev, scale=sign, offset=lc.final_offset_m, what="limit: final offset + HSTO")
-        fig.axes[1].legend(fontsize=SMALL_PT, loc="lower right")
-    else:
-        peak = float(np.abs(lc.response.extrema("a_steer")[1]).max())
-        _hlines(fig.axes[2], ev, scale=peak, symmetric=True, what="limit: RA x max|a_s|")
-        fig.axes[2].legend(fontsize=SMALL_PT, loc="lower right")
+    sign = 1.0 if lc.final_offset_m >= 0 else -1.0     # hsto_m, hsto_m_roll, hsto_driver_m
+    _hlines(fig.axes[1], ev, scale=sign, offset=lc.final_offset_m, what="limit: final offset + HSTO")
+    _beside(fig.axes[1])
+    return fig
+
+
+#: what a ratio's signals are, for the axis and the legend
+SIGNAL_WORDS = {"a_steer": "steered axle", "ay1": "unit 1's CG"}
+
+
+def _signal_label(name: str, n_units: int) -> str:
+    if name in SIGNAL_WORDS:
+        return f"{name} ({SIGNAL_WORDS[name]})"
+    if name == f"as{n_units}":
+        return f"{name} (the rearmost unit's sprung CG)"
+    if name == f"ay{n_units}":
+        return f"{name} (the rearmost unit's CG; its roll-axis point in the yaw-roll model)"
+    return name
+
+
+def _ratio(ev, response) -> Figure:
+    """A rearward amplification's evidence: its numerator's and its denominator's time histories
+    (the measure's reference points), their peaks marked, and every level's limit as the band
+    ±(limit × max|denominator|) the numerator must stay inside."""
+    num, den = ev.ratio
+    n = response.vehicle.n_units
+    unit = "rad/s" if num.startswith("r") else "m/s²"
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.2)
+    t = np.asarray(response.time)
+    for i, name in enumerate((den, num)):
+        ax.plot(t, response[name], color=PALETTE[i], lw=1.0, label=plain(_signal_label(name, n)))
+    (tn, yn), (td, yd) = response.extrema_many([num, den])
+    kn, kd = int(np.argmax(np.abs(yn))), int(np.argmax(np.abs(yd)))
+    ax.plot([td[kd]], [yd[kd]], "o", color=PALETTE[0], ms=4, label=f"max|{den}| = {abs(yd[kd]):.4g} {unit}")
+    ax.plot([tn[kn]], [yn[kn]], "o", color=PALETTE[1], ms=4, label=f"max|{num}| = {abs(yn[kn]):.4g} {unit}")
+    _hlines(ax, ev, scale=float(abs(yd[kd])), symmetric=True, what=f"limit: RA × max|{den}|")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(f"lateral {'yaw rate' if unit == 'rad/s' else 'acceleration'} [{unit}]")
+    import textwrap
+    fig.suptitle("\n".join(textwrap.wrap(_title(ev), 90) + [plain(f"RA = max|{num}| / max|{den}|")]),
+                 fontsize=SMALL_PT + 1)
+    ax.grid(True, lw=0.3)
+    _beside(ax)
+    keep = np.arange(0, t.size, max(1, t.size // 2000))
+    tag = unit.replace("/", "_per_").replace("²", "2")
+    fig.lcv_data = [{"time_s": float(t[k]), f"{den}_{tag}": float(response[den][k]),
+                     f"{num}_{tag}": float(response[num][k])} for k in keep]
     return fig
 
 
 def _single_sine(ev, key: str) -> Figure:
+    if ev.ratio:
+        return _ratio(ev, ev.result.response)
     ss = ev.result
     n = ss.vehicle.n_units
     fig, ax = new_figure(PAGE_WIDTH_IN, 3.4)
@@ -145,7 +201,7 @@ def _value(ev) -> Figure:
     if m.value is not None:
         ax.plot([m.value], [0.5], "o", color=PALETTE[0], ms=7, label=f"{m.key} = {m.value:.4g} {m.unit}")
     else:
-        ax.text(0.5, 0.5, f"not computed: {m.reason}", transform=ax.transAxes, ha="center", va="center",
+        ax.text(0.5, 0.5, plain(f"not computed: {m.reason}"), transform=ax.transAxes, ha="center", va="center",
                 fontsize=SMALL_PT, wrap=True)
     ax.set_xlim(lo, hi)
     ax.set_ylim(0, 1)

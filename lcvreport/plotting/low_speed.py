@@ -81,3 +81,55 @@ def fig_swept_path(turn, title: str, outlines_every_m: float = 2.0) -> Figure:
                  fontsize=8)
     fig.lcv_data = turn.rows()
     return fig
+
+
+def fig_swing(swing: dict, which: str, title: str, limits=()) -> Figure:
+    """A close-up of the corner a swing measure reads (``swing`` from
+    :meth:`lcvreport.measures.low_speed.LowSpeedTurn.swing`): ``which`` ``"tail"`` -- the rear
+    outer corner's path against its approach line, each limit drawn as a line that far beyond
+    it -- or ``"frontal"`` -- the front outer corner's path against the outside steer wheel's
+    circle, each limit as a circle that far outside it; the farthest point marked [m].
+    ``limits``: (label, distance [m]) pairs."""
+    from .style import LEVEL_STYLES, plain
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.6)
+    if not swing:
+        ax.text(0.5, 0.5, "not computed", transform=ax.transAxes, ha="center", va="center", fontsize=SMALL_PT)
+        ax.set_title(title, fontsize=8)
+        return fig
+    pts, at = swing["points"], swing["at"]
+    corner = "rear" if which == "tail" else "front"
+    ax.plot(*pts.T, color=PALETTE[0], lw=1.4, label=f"{corner} outer corner of {swing['unit']}")
+    if which == "tail":
+        y0 = swing["line_y_m"]
+        span = np.array([pts[:, 0].min(), pts[:, 0].max()])
+        ax.plot(span, [y0, y0], color="black", lw=0.9, label="its straight approach line")
+        for i, (label, d) in enumerate(limits):
+            ax.plot(span, [y0 - d] * 2, color="black", ls=LEVEL_STYLES[i % len(LEVEL_STYLES)], lw=0.8,
+                    label=plain(f"{label}: {d:.4g} m beyond it"))
+        ax.annotate("", (at[0], y0), tuple(at), arrowprops=dict(arrowstyle="<->", lw=0.8))
+        # the close-up: where the corner swings out, a few metres either side
+        window = max(3.0 * max(swing["value_m"], max((d for _l, d in limits), default=0.0)), 2.0)
+        ax.set_xlim(at[0] - 2 * window, at[0] + 2 * window)
+        ax.set_ylim(y0 - 1.6 * window, y0 + 0.6 * window)
+    else:
+        C, R = swing["centre"], swing["radius_m"]
+        th = np.linspace(0.0, math.radians(min(swing["angle_deg"], 360.0)), 400)
+        circle = lambda r: np.stack([C[0] + r * np.sin(th), C[1] - r * np.cos(th)], axis=1)  # noqa: E731
+        ax.plot(*circle(R).T, color="black", lw=0.9, label=f"outside steer wheel's circle (R = {R:g} m)")
+        for i, (label, d) in enumerate(limits):
+            ax.plot(*circle(R + d).T, color="black", ls=LEVEL_STYLES[i % len(LEVEL_STYLES)], lw=0.8,
+                    label=plain(f"{label}: {d:.4g} m outside it"))
+        u = (at - C) / np.hypot(*(at - C))
+        ax.annotate("", tuple(C + R * u), tuple(at), arrowprops=dict(arrowstyle="<->", lw=0.8))
+        window = max(3.0 * max(swing["value_m"], max((d for _l, d in limits), default=0.0)), 2.0)
+        ax.set_xlim(at[0] - 2 * window, at[0] + 2 * window)
+        ax.set_ylim(at[1] - 2 * window, at[1] + 2 * window)
+    ax.plot(*at, "o", color=PALETTE[1], ms=5, zorder=5, label=f"farthest: {swing['value_m']:.3f} m")
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("X [m]")
+    ax.set_ylabel("Y [m]")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=SMALL_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    fig.suptitle(title, fontsize=8)
+    fig.lcv_data = [{"X_m": float(x), "Y_m": float(y)} for x, y in pts]
+    return fig

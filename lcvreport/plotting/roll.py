@@ -32,17 +32,28 @@ def plot_rollover(threshold, ax=None) -> Figure:
             if at is not None:
                 lifted.setdefault(round(at, 9), []).append(axle)
         phi_last = np.degrees(np.asarray(g.path_phi_rad)[:, -1])
-        for event, (at, axles) in enumerate(sorted(lifted.items()), 1):
-            if event < len(a):
-                ax.annotate(", ".join(axles), (phi_last[event], a[event]), fontsize=SMALL_PT, xytext=(4, -8),
-                            textcoords="offset points")
+        events = [(event, axles) for event, (_at, axles) in enumerate(sorted(lifted.items()), 1) if event < len(a)]
+        # the labels in a column below their points, at least a line apart (lift-offs close together
+        # keep their labels apart): positions in points, from the data's height on an axes of
+        # about 180 pt (the figure's), the highest label first
+        top = max(float(np.max(a)) * 1.05, 1e-9)
+        label_pt = []
+        for event, _axles in sorted(events, key=lambda e: -a[e[0]]):
+            want = a[event] / top * 180.0 - 14.0
+            label_pt.append((event, min(want, label_pt[-1][1] - 10.0) if label_pt else want))
+        for event, y_pt in label_pt:
+            axles = dict(events)[event]
+            ax.annotate(", ".join(axles), (phi_last[event], a[event]), fontsize=SMALL_PT, ha="left",
+                        xytext=(14, y_pt - a[event] / top * 180.0), textcoords="offset points",
+                        arrowprops={"arrowstyle": "-", "lw": 0.4, "color": "gray"})
     ax.set_xlabel("outward roll of the sprung mass φ [deg]")
     ax.set_ylabel("lateral acceleration a_y [g]")
     ax.set_title(f"{threshold.vehicle.name}: static rollover threshold, lift-off axle by axle", fontsize=SMALL_PT + 1)
     ax.grid(True, lw=0.3)
     ax.set_xlim(left=0.0)
     ax.set_ylim(bottom=0.0)
-    ax.legend(handles=curves, fontsize=SMALL_PT, loc="lower right")
+    ax.legend(handles=curves, fontsize=SMALL_PT, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2,
+              frameon=False)
     rows = []
     for k, g in enumerate(threshold.groups, 1):
         events = {}

@@ -22,12 +22,29 @@ BODY = {"tractor": "#4a6fa5", "trailer": "#b0b7c3", "dolly": "#6b6b6b"}
 PAGE_WIDTH_IN = 6.2
 
 
+#: the line styles of a scheme's levels' limits, most demanding first
+LEVEL_STYLES = ("--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (1, 1)))
+
+
 #: smallest font size used anywhere [pt]
 SMALL_PT = 7.0
 
 
 #: display units of lengths: metres per display unit
 LENGTH_UNITS = {"m": 1.0, "in": M_PER_IN}
+
+
+def plain(text) -> str:
+    r"""``text`` as matplotlib sets it literally: every ``$`` escaped (``\$``), so that a user's
+    string -- a scheme's level, a source -- is never parsed as mathtext (an unknown TeX command
+    such as ``\href`` would stop the drawing), and line breaks as spaces.
+
+    Examples
+    --------
+    >>> plain(r"L1 $\href{x}{y}$")
+    'L1 \\$\\href{x}{y}\\$'
+    """
+    return " ".join(str(text).split()).replace("$", r"\$")
 
 
 def new_figure(width: float = PAGE_WIDTH_IN, height: float = 3.6, ncols: int = 1, nrows: int = 1, **kw):

@@ -176,12 +176,14 @@ def fig_pulse(ydc, names: list[str], title: str) -> Figure:
     sel = r.time <= end
     for i, name in enumerate(names):
         c = PALETTE[i % len(PALETTE)]
+        heavy = f"{name} (heavily damped: ζ ≥ {ydc.heavy_zeta:.3f})"
         ax.plot(r.time[sel], np.degrees(r[name][sel]), color=c, lw=1.0,
-                label=f"{name} (ζ {ydc.per_joint[i]:.3f})" if ydc.per_joint[i] is not None else name)
+                label=f"{name} (ζ {ydc.per_joint[i]:.3f})" if ydc.per_joint[i] is not None else heavy)
         t, v = ydc.extrema[i]
         used = len(ydc.amplitudes[i]) + 1 if len(ydc.amplitudes[i]) else 0
         keep = np.arange(t.size) < used
         ax.plot(t[keep & (t <= end)], np.degrees(v[keep & (t <= end)]), "o", ms=3, color=c)
+    ax.margins(y=0.12)                       # the first peaks clear of the frame
     ax.set_xlabel("time [s]")
     ax.set_ylabel("articulation angle [deg]")
     ax.grid(True, lw=0.3)

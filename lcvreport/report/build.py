@@ -36,8 +36,8 @@ from typing import Callable
 from ..units import MPS_PER_KPH
 from .notebooks import (NOTEBOOKS, PAPERS, ReportError, _execute_unchecked, execute, export_html, export_pdf, merge,
                         notebook_dir)
-from .publish import (MANIFEST, OutputFolderError, _discard, _folder_state, _prepare, _publish, _stage,
-                      check_output_folder)
+from .publish import (OutputFolderError, WriterLock, _discard, _folder_state, _prepare, _publish, _stage,
+                      check_output_folder, write_manifest)
 from .tables import md_text
 
 THESIS_TITLE = "Effect of conicity and ply steer on LCV yaw plane motion: the dissertation recomputed"
@@ -154,6 +154,12 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
     from ..model.vehicle_file import dumps_vehicle
     version, progress = _start(paper, progress)
     speed_kph = DEFAULT_SPEED_KPH if speed_mps is None else speed_mps / MPS_PER_KPH
+    if criteria_file is not None:               # through the one guarded reader, before anything is written
+        from ..measures.criteria import CriteriaError, load_criteria
+        try:
+            load_criteria(criteria_file)
+        except CriteriaError as exc:
+            raise ReportError(f"criteria file {criteria_file}: {exc}") from None
 
     def params_of(staged: Path) -> dict:
         vehicle_file = staged / "vehicle.toml"
@@ -192,11 +198,16 @@ def build_scheme_report(vehicle, scheme_file: str | Path, out_dir: str | Path, t
     """
     import hashlib
 
-    from ..measures.scheme import load_scheme
     from ..model.vehicle_file import dumps_vehicle
+    from ..measures.scheme import SchemeError, loads_scheme
+    from ..util.files import FileInputError, read_file_bytes
     version, progress = _start(paper, progress)
-    scheme_bytes = Path(scheme_file).read_bytes()
-    scheme = load_scheme(scheme_file)
+    try:                        # the one guarded reader: a FIFO or a device is refused, never read
+        scheme_bytes = read_file_bytes(scheme_file, "scheme file")
+        text = scheme_bytes.decode("utf-8")
+        scheme = loads_scheme(text[1:] if text.startswith("\ufeff") else text)
+    except (FileInputError, UnicodeDecodeError, SchemeError) as exc:
+        raise ReportError(f"scheme file {scheme_file}: {exc}") from None
     text = vehicle_text if vehicle_text is not None else \
         dumps_vehicle(vehicle, header=f"The vehicle of this report ({source or vehicle.name}).")
     sha_vehicle = hashlib.sha256(text.encode("utf-8")).hexdigest()
@@ -233,9 +244,18 @@ def _one_notebook(out_dir, stem: str, params_of, title: str, intro: str, pdf: bo
     """A one-notebook report: ``out_dir`` checked, the report written aside -- its ``data/``,
     the notebook ``stem`` executed with ``fast``, ``data_dir`` and ``params_of(staged)``,
     merged under ``title`` and ``intro`` (``{stamp}``: the date), exported -- and published
-    into ``out_dir`` whole; nothing left behind on a failure or an interruption."""
-    import os
+    into ``out_dir`` whole; nothing left behind on a failure or an interruption; one writer at a
+    time (:class:`~lcvreport.report.publish.WriterLock`)."""
     out = check_output_folder(out_dir)
+    with WriterLock(out):
+        out = check_output_folder(out_dir)          # again, now that no other report writes it
+        return _one_notebook_locked(out, stem, params_of, title, intro, pdf, paper, pdf_title, written_by, progress,
+                                    fast, toc)
+
+
+def _one_notebook_locked(out: Path, stem: str, params_of, title: str, intro: str, pdf: bool, paper: str,
+                         pdf_title: str, written_by: str, progress, fast: bool, toc: bool) -> dict:
+    import os
     before = _folder_state(out)
     staged = _stage(out)
     try:
@@ -262,7 +282,6 @@ def _finish_single(staged: Path, out: Path, before, part: tuple, title: str, int
                    paper: str, written_by: str, progress, toc: bool = True) -> dict:
     """The end of a one-notebook report (the assessment, a study): merge, HTML, PDF, the
     manifest, then the staged folder published into ``out``; the files written, by kind."""
-    import json
     nb = merge([part], title, intro)
     export_html(nb, staged)
     progress("html written")
@@ -271,9 +290,7 @@ def _finish_single(staged: Path, out: Path, before, part: tuple, title: str, int
         export_pdf(nb, staged, pdf_title, paper=paper, title_page=False, toc=toc)
         written["pdf"] = "report.pdf"
         progress("pdf written")
-    files = sorted(p.name for p in staged.iterdir()) + [MANIFEST]
-    (staged / MANIFEST).write_text(json.dumps({"written_by": written_by, "files": files}, indent=1),
-                                   encoding="utf-8")
+    write_manifest(staged, written_by)
     _publish(staged, out, before)
     return written
 

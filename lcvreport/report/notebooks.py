@@ -14,6 +14,7 @@ from ..model.presets import PRESETS, load_preset
 from ..model.yaw_plane.loads import CONVENTIONS
 from ..ranges import RANGES
 from ..units import MPS_PER_KPH, MPS_PER_MPH
+from .tables import md_text
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
 
@@ -359,14 +360,16 @@ def merge(executed: list[tuple[str, str, str, Path]], title: str, intro: str):
     nb.metadata = {"title": title, "kernelspec": {"name": "python3", "display_name": "Python 3", "language": "python"},
                    "language_info": {"name": "python"}}
     html_only = {"tags": [HTML_ONLY]}    # the PDF has its own title page and table of contents
-    cells = [nbformat.v4.new_markdown_cell("# " + title, metadata=html_only), nbformat.v4.new_markdown_cell(intro)]
+    # the title may hold a user's text (a scheme's name): set literally, never as Markdown or TeX
+    cells = [nbformat.v4.new_markdown_cell("# " + md_text(title), metadata=html_only),
+             nbformat.v4.new_markdown_cell(intro)]
     if len(executed) > 1:
         toc = ["## Contents", ""] + [f"{i + 1}. [{t}](#{a})" for i, (_s, a, t, _p) in enumerate(executed)]
         cells.append(nbformat.v4.new_markdown_cell("\n".join(toc), metadata=html_only))
     for stem, anchor, part_title, path in executed:
         src = nbformat.read(path, as_version=4)
         if len(executed) > 1:
-            cells.append(nbformat.v4.new_markdown_cell(f'<a id="{anchor}"></a>\n\n# {part_title}'))
+            cells.append(nbformat.v4.new_markdown_cell(f'<a id="{anchor}"></a>\n\n# {md_text(part_title)}'))
         for cell in src.cells:
             tags = cell.get("metadata", {}).get("tags", [])
             if "parameters" in tags or "injected-parameters" in tags or "report-skip" in tags:
@@ -385,12 +388,16 @@ def merge(executed: list[tuple[str, str, str, Path]], title: str, intro: str):
     return nb
 
 
-#: the part of MathJax 2 (Debian's libjs-mathjax, 54 MB in all) the reports' configuration
-#: ``TeX-AMS_CHTML-full,Safe`` loads: the loader, the combined configuration, the TeX input and
-#: CommonHTML output jax, the extensions (Safe, the menu and zoom loaded on use) and the TeX web
-#: fonts -- 1.6 MB, copied into every report so that a copied folder keeps its mathematics
-MATHJAX_PARTS = ("MathJax.js", "config/TeX-AMS_CHTML-full.js", "extensions", "jax/input/TeX", "jax/output/CommonHTML",
-                 "jax/element", "fonts/HTML-CSS/TeX/woff")
+#: the reports' MathJax configuration: the combined TeX/CommonHTML configuration and ``Safe``
+#: (``config/Safe.js``, which loads the Safe extension: ``\href{javascript:...}``, ``\style`` and
+#: ``\class`` in typeset text stay dead)
+MATHJAX_CONFIG = ("TeX-AMS_CHTML-full", "Safe")
+#: the part of MathJax 2 (Debian's libjs-mathjax, 54 MB in all) :data:`MATHJAX_CONFIG` loads: the
+#: loader, every configuration file it names, the TeX input and CommonHTML output jax, the
+#: extensions (Safe, the menu and zoom loaded on use) and the TeX web fonts -- 1.6 MB, copied into
+#: every report so that a copied folder keeps its mathematics
+MATHJAX_PARTS = ("MathJax.js", *(f"config/{name}.js" for name in MATHJAX_CONFIG), "extensions", "jax/input/TeX",
+                 "jax/output/CommonHTML", "jax/element", "fonts/HTML-CSS/TeX/woff")
 
 
 def copy_mathjax(dst: Path) -> None:
@@ -407,9 +414,13 @@ def copy_mathjax(dst: Path) -> None:
 def export_html(nb, out_dir: Path) -> Path:
     """Self-contained HTML (figures inline), the MathJax it needs copied next to it."""
     from nbconvert import HTMLExporter
+    # embed_images stays off: with it nbconvert re-parses every inline HTML tag of the Markdown on
+    # its own (to find <img>), which closes md_text's <span class="tex2jax_ignore"> at once and
+    # leaves the user's text outside it, where MathJax typesets it (figures are outputs, inline
+    # either way; no Markdown cell of the reports holds an image)
     exporter = HTMLExporter(template_name="lab", exclude_input=True, exclude_input_prompt=True,
-                            exclude_output_prompt=True, embed_images=True)
-    exporter.mathjax_url = "mathjax/MathJax.js?config=TeX-AMS_CHTML-full,Safe"
+                            exclude_output_prompt=True, embed_images=False)
+    exporter.mathjax_url = "mathjax/MathJax.js?config=" + ",".join(MATHJAX_CONFIG)
     exporter.require_js_url = ""
     body, _ = exporter.from_notebook_node(nb)
     body = body.replace('<script src=""></script>', "")

@@ -185,17 +185,25 @@ class Table:
     digits : int
         Significant digits of numbers.
     columns : list of str, optional
+    headers : dict, optional
+        Column -> header text set as given (a user's name: a scheme's level ``L1_kph`` is not a
+        unit suffix); the other columns' headers come from :func:`header_label`.
+    portrait : bool
+        Keep the table on a portrait page (smaller type, down to 6 pt, before a landscape page):
+        a verdict table that must stay on page 1.
     """
 
     def __init__(self, number: str, caption: str, rows: list[dict], digits: int = 4,
-                 columns: Iterable[str] | None = None):
+                 columns: Iterable[str] | None = None, headers: dict | None = None, portrait: bool = False):
         self.number, self.caption, self.rows, self.digits = number, caption, rows, digits
+        self.portrait = portrait
         self.columns = list(columns) if columns is not None else (list(rows[0].keys()) if rows else [])
         self.cells = [[fmt(r.get(c, ""), digits) for c in self.columns] for r in rows]
         # a numeric column: numbers, or blanks where a row has none (a coupling that does not exist)
         self.numeric = [any(_is_number(r.get(c)) for r in rows) and
                         all(_is_number(r.get(c)) or r.get(c) in BLANKS for r in rows) for c in self.columns]
-        self.headers = [header_label(c) for c in self.columns]
+        given = headers or {}
+        self.headers = [" ".join(str(given[c]).split()) if c in given else header_label(c) for c in self.columns]
         if len(rows) == 1 and len(self.columns) > TRANSPOSE_COLUMNS:
             # one row of many columns reads better as a list of quantities
             values = [rows[0].get(c, "") for c in self.columns]
@@ -219,8 +227,11 @@ class Table:
         """Column widths [pt] (numbers: their natural width, text: a paragraph width),
         whether the table needs a landscape page, the font size [pt] and the space
         between columns [pt].  Widths are measured with the PDF's font (DejaVu Serif)."""
-        for line_pt, landscape, size in ((PORTRAIT_LINE_PT, False, 8.0), (LANDSCAPE_LINE_PT, True, 8.0),
-                                         (LANDSCAPE_LINE_PT, True, 7.0)):
+        tries = ((PORTRAIT_LINE_PT, False, 8.0), (LANDSCAPE_LINE_PT, True, 8.0), (LANDSCAPE_LINE_PT, True, 7.0))
+        if self.portrait:               # a table that must stay on its page: smaller type before a turned page
+            tries = ((PORTRAIT_LINE_PT, False, 8.0), (PORTRAIT_LINE_PT, False, 7.0), (PORTRAIT_LINE_PT, False, 6.0),
+                     *tries[1:])
+        for line_pt, landscape, size in tries:
             natural, text_min, text_full = [], 0.0, 0.0
             for k in range(len(self.headers)):
                 words = self.headers[k].split() or [""]
@@ -241,7 +252,7 @@ class Table:
             # portrait when the text columns get at least 40 % of the width they would like
             # beyond their minimum
             share = (room - text_min) / (text_full - text_min) if text_full > text_min else 1.0
-            if text_min <= room and (share >= 0.4 or size < 8.0):
+            if text_min <= room and (share >= 0.4 or size < 8.0 or (self.portrait and size <= 6.0)):
                 break
         # text columns: their minimum width, plus a share of what is left in proportion to
         # how much more they would need (the table never exceeds the line when it can)
@@ -351,13 +362,14 @@ def show_figure(fig, number: str, caption: str, data_dir: str | Path | None) -> 
 
 
 def show_table(number: str, caption: str, rows: list[dict], data_dir: str | Path | None, digits: int = 4,
-               columns: Iterable[str] | None = None) -> None:
-    """Display ``rows`` as a :class:`Table` under ``Table <number>. <caption>``; save CSV.
+               columns: Iterable[str] | None = None, headers: dict | None = None, portrait: bool = False) -> None:
+    """Display ``rows`` as a :class:`Table` under ``Table <number>. <caption>``; save CSV
+    (``headers``: column -> header set as given; ``portrait``: kept on a portrait page; :class:`Table`).
 
     Returns None, so a call ending a notebook cell does not display the table twice."""
     from IPython.display import display
     if data_dir is not None:
         write_csv(Path(data_dir) / f"table_{_slug(number)}.csv", rows)
-    display(Table(number, caption, rows, digits, columns))
+    display(Table(number, caption, rows, digits, columns, headers, portrait))
 
 

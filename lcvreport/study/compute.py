@@ -37,13 +37,15 @@ def compute_chunk(study: Study, case_ids) -> dict:
     table = study.factor_table(ids)
     speeds = study.speeds_mps(table) if table else np.full(ids.size, np.nan)
     scales = np.asarray(table.get("tire_scale", np.ones(ids.size)), dtype=float)
-    params = study.batch_parameters(table)
+    params = study.batch_parameters(table)                  # the scale factors alone: case vehicles start here
+    folded = study.batch_parameters(table, payloads=True)   # with the payloads: what the yaw-plane batch takes
     cols = {"case_id": ids}
     cols.update({name: (arr if name == "load_units" else np.asarray(arr, dtype=float)) for name, arr in table.items()})
     for m in study.measures:
         cols[m] = np.full(ids.size, np.nan)
     v = study.vehicle
-    batched = set(study.measures) & set(BATCHED) if v.steered_axles else set()
+    # a batch holds one geometry: a payload off its unit's CG moves the CG, so case by case
+    batched = set(study.measures) & set(BATCHED) if v.steered_axles and not study.moves_geometry else set()
     if missing_roll_data(v) is not None:          # null case by case, with the missing key named
         batched -= {k for g, keys in BATCH_GROUPS.items() if FAMILIES[g].model == "yaw_roll" for k in keys}
     groups = [g for g, keys in BATCH_GROUPS.items() if batched & set(keys)]
@@ -57,14 +59,14 @@ def compute_chunk(study: Study, case_ids) -> dict:
         uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
         for g, (u, ts) in enumerate(uniq):
             rows = np.flatnonzero(inverse.ravel() == g)
-            values = {k: arr[rows] for k, arr in params.items()        # the yaw plane reads no roll key
+            values = {k: arr[rows] for k, arr in folded.items()        # the yaw plane reads no roll key
                       if k.split(".", 1)[1] not in ROLL_PARAMETERS}
             batches = {"yaw_plane": VariantBatch(v, values)}
             for group in groups:
                 model = FAMILIES[group].model
                 if model not in batches:              # every case's own vehicle, its coefficients exact
                     batches[model] = VariantBatch.of_vehicles(
-                        v, [study.case_vehicle(params, int(k)) for k in rows], model)
+                        v, [study.case_vehicle(params, int(k), table) for k in rows], model)
                 case = MeasureCase(v, float(u), float(ts), RA_FREQUENCY_HZ, None if F is None else F[rows])
                 arrays = FAMILIES[group].compute_batched(batches[model], case)
                 for name, arr in zip(BATCH_GROUPS[group], arrays):

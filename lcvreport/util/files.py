@@ -53,28 +53,16 @@ def _size_text(n: int) -> str:
     return f"{n} bytes ({n / (1 << 20):.3g} MiB)" if n >= 1 << 20 else f"{n} bytes"
 
 
-def read_text_file(path: str | Path, what: str = "file", max_bytes: int = MAX_BYTES) -> str:
-    """The text of the regular file ``path``: at most ``max_bytes``, UTF-8 (a leading
-    byte-order mark dropped).
-
-    Parameters
-    ----------
-    path : str or Path
-    what : str
-        What the file is, for the message (``"vehicle file"``, ``"steer table"``).
-    max_bytes : int
-        The largest file accepted [bytes].
-
-    Returns
-    -------
-    str
+def read_file_bytes(path: str | Path, what: str = "file", max_bytes: int = MAX_BYTES) -> bytes:
+    """The bytes of the regular file ``path`` (at most ``max_bytes``), with every refusal of
+    :func:`read_text_file` but the decoding: what a report copies byte for byte (a scheme file,
+    whose SHA-256 the report prints).
 
     Raises
     ------
     FileInputError
-        A missing or unreadable file, anything but a regular file (refused without reading
-        from it, so a FIFO or a device never blocks), a file larger than ``max_bytes``,
-        text that is not UTF-8.  One line naming the file.
+        A missing or unreadable file, anything but a regular file (refused without reading from
+        it), a file larger than ``max_bytes``.  One line naming the file.
     """
     path = Path(path)
     try:
@@ -104,6 +92,33 @@ def read_text_file(path: str | Path, what: str = "file", max_bytes: int = MAX_BY
     if len(data) > max_bytes:
         raise FileInputError(f"{path} has more than {_size_text(max_bytes)}; a {what} has at most "
                              f"{_size_text(max_bytes)}")
+    return data
+
+
+def read_text_file(path: str | Path, what: str = "file", max_bytes: int = MAX_BYTES) -> str:
+    """The text of the regular file ``path``: at most ``max_bytes``, UTF-8 (a leading
+    byte-order mark dropped).
+
+    Parameters
+    ----------
+    path : str or Path
+    what : str
+        What the file is, for the message (``"vehicle file"``, ``"steer table"``).
+    max_bytes : int
+        The largest file accepted [bytes].
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    FileInputError
+        A missing or unreadable file, anything but a regular file (refused without reading
+        from it, so a FIFO or a device never blocks), a file larger than ``max_bytes``,
+        text that is not UTF-8.  One line naming the file.
+    """
+    data = read_file_bytes(path, what, max_bytes)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -164,7 +179,68 @@ def read_csv(path: str | Path, what: str, columns: tuple[str, ...], optional: tu
 
 
 class TomlNumberError(ValueError):
-    """A TOML number Python cannot convert (an integer of thousands of digits), with its line and key."""
+    """What tomllib cannot say in one line: a TOML number Python cannot convert (an integer of
+    thousands of digits), a key of thousands of dotted parts, nesting that exhausts the stack --
+    with its line and key where there is one."""
+
+
+#: the most dotted parts a key of a user's TOML file may have (tomllib takes time quadratic in them:
+#: a 40,000-part key would hang it); no file of the toolkit needs more than 4
+MAX_KEY_PARTS = 32
+
+
+def _code_of(text: str) -> str:
+    """``text`` with every string literal replaced by ``S`` and every comment removed (line breaks
+    kept): what remains are keys, values and punctuation -- so that a period in a comment or a
+    quoted string is not read as a key's dot."""
+    out, i, n = [], 0, len(text)
+    while i < n:
+        c = text[i]
+        if c == "#":
+            j = text.find("\n", i)
+            i = n if j < 0 else j
+            continue
+        if c in "\"'":
+            triple = text.startswith(c * 3, i)
+            end, i = (c * 3 if triple else c), i + (3 if triple else 1)
+            while i < n:
+                if c == '"' and text[i] == "\\":
+                    i += 2
+                    continue
+                if text.startswith(end, i):
+                    i += len(end)
+                    break
+                if not triple and text[i] == "\n":
+                    break
+                if text[i] == "\n":
+                    out.append("\n")
+                i += 1
+            out.append("S")
+            continue
+        out.append(c)
+        i += 1
+    return "".join(out)
+
+
+def check_key_parts(text: str, limit: int = MAX_KEY_PARTS) -> tuple[int, int] | None:
+    r"""(line, parts) of the first key of more than ``limit`` dotted parts in a TOML text, or None;
+    keys in table headers, on the left of ``=``, and in inline tables -- not periods in comments,
+    strings or numbers.
+
+    Examples
+    --------
+    >>> check_key_parts("# loads [t]: 5.4. 8.1. 7.9. 7.9. 8.2. 8.0. 7.7. 7.8. 8.3. 8.1. 7.9. 8.0. 8.2. 7.9. 8.1. 8.0.\nx = 1.5")
+    >>> check_key_parts("a" + ".a" * 40 + " = 1")
+    (1, 41)
+    """
+    import re
+    code = _code_of(text)
+    keys = re.finditer(r"(?m)^[ \t]*\[\[?([^\]\n]*)\]|(?:^|[{,])[ \t]*([^=\[\]{},\n]*?)[ \t]*=", code)
+    for m in keys:
+        key = m.group(1) if m.group(1) is not None else m.group(2)
+        if key.count(".") >= limit:
+            return code.count("\n", 0, m.start()) + 1, key.count(".") + 1
+    return None
 
 
 def loads_toml(text: str) -> dict:
@@ -187,10 +263,17 @@ def loads_toml(text: str) -> dict:
     """
     import re
     import tomllib
+    long_key = check_key_parts(text)
+    if long_key is not None:
+        raise TomlNumberError(f"line {long_key[0]}: a key of {long_key[1]} dotted parts; a file of the toolkit needs "
+                              "at most 4")
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError:
         raise
+    except (RecursionError, MemoryError):
+        raise TomlNumberError("not readable: its TOML nests too deeply (a file of the toolkit nests its tables "
+                              "and arrays 4 deep)") from None
     except ValueError as exc:
         m = re.search(r"[0-9_]{1000,}", text)
         if m is None:

@@ -82,18 +82,37 @@ def _controller():
     return c
 
 
+#: the process-wide limit: how many threads are inside a block, and what restores the caller's
+#: counts when the last leaves (BLAS's thread count is one setting of the process, not of a thread:
+#: a block that restored it while another thread was still computing gave that thread's products
+#: another summation order, and its last bits differed from a serial run's)
+_active = {"count": 0, "limit": None}
+_active_lock = threading.Lock()
+
+
 @contextmanager
 def blas_threads_limited():
     """Within the block, every loaded BLAS library runs ``LCV_BLAS_THREADS`` (default 1) threads;
-    the caller's counts are restored after.  Nested blocks limit once."""
+    the caller's counts are restored after the last block of any thread ends (so a thread's
+    numbers never depend on another's timing).  Nested blocks limit once."""
     if getattr(_inside, "depth", 0):
         yield
         return
     _inside.depth = 1
+    with _active_lock:
+        if _active["count"] == 0:
+            limit = _controller().limit(limits=_threads_wanted(), user_api="blas")
+            limit.__enter__()
+            _active["limit"] = limit
+        _active["count"] += 1
     try:
-        with _controller().limit(limits=_threads_wanted(), user_api="blas"):
-            yield
+        yield
     finally:
+        with _active_lock:
+            _active["count"] -= 1
+            if _active["count"] == 0:
+                _active["limit"].__exit__(None, None, None)
+                _active["limit"] = None
         _inside.depth = 0
 
 

@@ -58,7 +58,7 @@ static void logmsg(Instance2 *c, fmi2Status status, const char *fmt, ...)
     if (!c || !c->cb.logger) return;
     if (!c->m.logging_on && status < fmi2Warning) return;
     va_start(ap, fmt);
-    format_log_message(esc, sizeof esc, fmt, ap);
+    format_log_message(esc, sizeof esc, 1, fmt, ap);
     va_end(ap);
     c->cb.logger(c->cb.componentEnvironment, c->m.name, status, log_category(status), esc);
 }
@@ -310,6 +310,10 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real currentCommunicationPoint, fm
         return fmi2Error;
     }
     if (!allowed(c, "fmi2DoStep", MASK_fmi2DoStep)) return fmi2Error;
+    if (!isfinite(currentCommunicationPoint)) {
+        logmsg(c, fmi2Error, "fmi2DoStep: currentCommunicationPoint is not finite (%g)", currentCommunicationPoint);
+        return fmi2Error;
+    }
     int r = model_do_step(&c->m, communicationStepSize);
     if (r < 0) {
         logmsg(c, fmi2Error, "%s", c->m.msg);

@@ -35,7 +35,7 @@ static void logmsg(Instance3 *c, fmi3Status status, const char *fmt, ...)
     if (!c || !c->log) return;
     if (!c->m.logging_on && status < fmi3Warning) return;
     va_start(ap, fmt);
-    format_log_message(esc, sizeof esc, fmt, ap);
+    format_log_message(esc, sizeof esc, 0, fmt, ap);
     va_end(ap);
     c->log(c->env, status, log_category(status), esc);
 }

@@ -9,13 +9,13 @@
 
 #include "fmu_common.h"
 
-void format_log_message(char *out, size_t size, const char *fmt, va_list ap)
+void format_log_message(char *out, size_t size, int double_percent, const char *fmt, va_list ap)
 {
     char buf[1200];
     size_t j = 0;
     vsnprintf(buf, sizeof buf, fmt, ap);
     for (size_t i = 0; buf[i] && j + 2 < size; ++i) {
-        if (buf[i] == '%') out[j++] = '%';
+        if (double_percent && buf[i] == '%') out[j++] = '%';
         out[j++] = buf[i];
     }
     out[j] = '\0';

@@ -6,10 +6,10 @@
 #include <stdarg.h>
 #include <stddef.h>
 
-/* printf-format into out (size bytes) with every '%' doubled: the finished text is passed
-   to the host's logger as the message itself, so hosts that apply printf formatting print
-   it as is and hosts that do not (Python hosts) get the text. */
-void format_log_message(char *out, size_t size, const char *fmt, va_list ap);
+/* printf-format into out (size bytes); with double_percent, every '%' doubled: an FMI 2.0
+   logger's message is itself a printf format (the host formats it, so a literal '%' must be
+   "%%"), an FMI 3.0 logMessage's is plain text (no doubling: "[-20, 20] %" stays one '%'). */
+void format_log_message(char *out, size_t size, int double_percent, const char *fmt, va_list ap);
 
 /* the FMI log category of a status (FMI 2 and 3 number them alike: 0 OK, 1 Warning, 2 Discard,
    3 Error, 4 Fatal): logStatusWarning, logStatusError or logAll */

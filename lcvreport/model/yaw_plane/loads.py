@@ -97,6 +97,9 @@ def check_unit_names(vehicle: Vehicle, units) -> list[str]:
         Naming the unknown or repeated unit and the valid ones.
     """
     valid = vehicle.unit_names
+    if isinstance(units, str) or not hasattr(units, "__iter__"):
+        raise KeyError(f"load_units must be a list of unit names of {vehicle.name} ({', '.join(valid)}), got "
+                       f"{units!r}")
     seen = []
     for name in units:
         if name not in valid:
