@@ -21,6 +21,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``presets``          the six thesis vehicles, shipped as vehicle files
     ``plausibility``     warnings for legal but implausible numbers (unit typos)
     ``statics``          static axle and coupling loads that follow the masses (mass factors, payloads)
+    ``base``             the model object: the VehicleModel protocol, MODELS, build_model
     ``body``             the body of every unit: kind, extent, corners, overall length, poses
     ``linear``           the model seam: LinearModel (what analysis needs of any linear model), MODELS
     ``yaw_plane/``       the linear yaw-plane model of the thesis, ``M x' = S x + F``:
@@ -33,6 +34,9 @@ Where things live (a folder is a layer; each imports only the ones above it)
         ``equations``    M, S and the input matrices with roll rates and roll angles; load transfer outputs
     ``low_speed/``       the low-speed kinematic model:
         ``kinematics``   pull points, the heading law, the integration along a path (scipy)
+    ``nonlinear/``       the nonlinear planar model (docs/nonlinear.md): any angle, saturating tires:
+        ``model``        the planar multibody chain, Kane's equations, the held speed, outputs
+        ``tires``        the tire laws, linear and brush, vectorized over the axles
 ``manoeuvres/``          **what the driver and the road do**, independent of any model:
     ``steer``            steer inputs as continuous functions (step, sine, pulse, table, lane change)
     ``paths``            the paths of the low-speed model (straight, straight-arc-straight)
@@ -48,13 +52,14 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``roll``             the a_y - phi curve of the static rollover threshold
     ``assessment``       an assessment's evidence with every level's limit drawn on it
     ``charts``           grouped bars and fitted curves
-``analysis/``            **linear analysis** (numpy, scipy):
+``analysis/``            **analysis of the models** (numpy, scipy):
     ``modes``            eigenvalues, damping, mode shapes
     ``steady``           steady state -S^-1 F, the steady state with a held yaw rate, the trim
     ``frequency``        G(j w) from the steer to every unit's acceleration, RA(f)
     ``exact``            exact response to steer inputs (augmented exponential)
     ``extrema``          extrema between samples (Hermite), the doubling scan
-    ``time_response``    TimeResponse: every exact response, signals by name and unit, extrema, tables, plot
+    ``time_response``    the Response protocol; TimeResponse (exact) and SampledResponse (integrated): signals, extrema, plot
+    ``integrate``        one implicit integration of any model (Radau), restarted at the steer's breakpoints
     ``response``         simulate, step_response: inputs held over intervals (exact)
     ``discretize``       exact zero-order-hold discretization, its cache
     ``modal``            modal superposition, exact and the thesis' method

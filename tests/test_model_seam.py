@@ -26,7 +26,7 @@ U = 24.0
 def test_the_yaw_plane_is_the_default_linear_model():
     v = load_preset("aucnat")
     m = linear_model(v)
-    assert isinstance(m, LinearModel) and m is system_coefficients(v) and m.kind == "yaw_plane"
+    assert isinstance(m, LinearModel) and m is system_coefficients(v) and m.name == "yaw_plane" and m.kind == "linear"
     assert len(m.state_names) == len(m.state_units) == m.n_states == 2 * v.n_units
     assert linear_model(v, "yaw-plane") is m                     # the command line's spelling
 

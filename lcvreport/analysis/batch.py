@@ -33,12 +33,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..model.linear import linear_model
+from ..model.linear import linear_model, stiffness
 from ..model.vehicle import Vehicle
 from ..util.numerics import solve_scaled
 
 #: the coefficients the batch varies, and the parameters it can vary
 COEFFICIENTS = ("M0", "M1", "S0", "Sinv", "Su", "Skin", "Bdelta")
+#: the coefficients of the stiffness S(u, s) (:func:`lcvreport.model.linear.stiffness`)
+STIFFNESS = ("S0", "Sinv", "Su", "Skin")
 UNIT_PARAMETERS = ("mass_kg", "yaw_inertia_kg_m2")
 AXLE_PARAMETERS = ("cornering_stiffness_N_per_rad", "aligning_stiffness_Nm_per_rad", "longitudinal_stiffness_N")
 
@@ -193,7 +195,7 @@ class VariantBatch:
         c = self.coefficients
         u = float(speed_mps)
         M = c["M0"] + u * c["M1"]
-        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        S = stiffness(c, u, tire_scale)
         return solve_scaled(M, S)
 
     def eigenvalues(self, speed_mps: float, tire_scale: float = 1.0) -> np.ndarray:
@@ -213,7 +215,7 @@ class VariantBatch:
         c = self.coefficients
         u = float(speed_mps)
         M = c["M0"] + u * c["M1"]
-        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        S = stiffness(c, u, tire_scale)
         b = tire_scale * c["Bdelta"]
         w = 2 * np.pi * float(f_hz)
         x = np.linalg.solve(1j * w * M - S, b[..., None])[..., 0]
@@ -256,7 +258,7 @@ class VariantBatch:
         c = {k: (v if rows is None else v[rows]) for k, v in self.coefficients.items()}
         u = float(speed_mps)
         M = (c["M0"] + u * c["M1"])[:, None]
-        S = (tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"])[:, None]
+        S = stiffness(c, u, tire_scale)[:, None]
         b = np.broadcast_to((tire_scale * c["Bdelta"])[:, None], f_hz.shape + c["Bdelta"].shape[-1:])
         w = (2 * np.pi * f_hz)[..., None, None]
         x = np.linalg.solve(1j * w * M - S, b[..., None])[..., 0]
@@ -273,7 +275,7 @@ class VariantBatch:
         c = self.coefficients
         u = float(speed_mps)
         M = c["M0"] + u * c["M1"]
-        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        S = stiffness(c, u, tire_scale)
         A = solve_scaled(M, S)
         b = np.linalg.solve(M, (tire_scale * c["Bdelta"])[..., None])[..., 0]
         lam, V = np.linalg.eig(A)
@@ -319,7 +321,7 @@ class VariantBatch:
         n, B = linear_model(self.vehicle, self.model).n_states, rows.size
         m = n + 2 if positions else n
         M = c["M0"] + u * c["M1"]
-        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        S = stiffness(c, u, tire_scale)
         AG = solve_scaled(M, np.concatenate([S, np.broadcast_to(np.eye(n), (B, n, n))], axis=-1))
         A_x, Minv = AG[..., :n], AG[..., n:]
         Aa = np.zeros((B, m, m))
@@ -480,7 +482,7 @@ class VariantBatch:
         c = {k: a[rows] for k, a in self.coefficients.items()}
         n = linear_model(self.vehicle, self.model).n_states
         M = c["M0"] + u * c["M1"]
-        S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        S = stiffness(c, u, tire_scale)
         AG = solve_scaled(M, np.concatenate([S, np.broadcast_to(np.eye(n), (rows.size, n, n))], axis=-1))
         A_x, Minv = AG[..., :n], AG[..., n:]
         b = np.einsum("bij,bj->bi", Minv, tire_scale * c["Bdelta"])
@@ -504,7 +506,7 @@ class VariantBatch:
         n = c["M0"].shape[-1]
         B = self.size
         K = np.zeros((B, n + 1, n + 1))
-        K[:, :n, :n] = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+        K[:, :n, :n] = stiffness(c, u, tire_scale)
         K[:, :n, n] = tire_scale * c["Bdelta"]
         K[:, n, 1] = 1.0
         rhs = np.zeros((B, n + 1))
@@ -519,7 +521,7 @@ class VariantBatch:
         c = self.coefficients
         u = kph_to_mps(np.asarray(v_kph, dtype=float))[..., None, None]          # (B, J, 1, 1)
         M = c["M0"][:, None] + u * c["M1"][:, None]
-        S = tire_scale * (c["S0"][:, None] + c["Sinv"][:, None] / u) + c["Skin"][:, None] + u * c["Su"][:, None]
+        S = stiffness({k: c[k][:, None] for k in STIFFNESS}, u, tire_scale)
         return np.linalg.eigvals(solve_scaled(M, S)).real.max(axis=-1)
 
     def values_at(self, variants: np.ndarray, v_kph: np.ndarray, tire_scale: float) -> np.ndarray:
@@ -528,6 +530,6 @@ class VariantBatch:
         c = self.coefficients
         u = kph_to_mps(np.asarray(v_kph, dtype=float))[:, None, None]
         M = c["M0"][variants] + u * c["M1"][variants]
-        S = tire_scale * (c["S0"][variants] + c["Sinv"][variants] / u) + c["Skin"][variants] + u * c["Su"][variants]
+        S = stiffness({k: c[k][variants] for k in STIFFNESS}, u, tire_scale)
         return np.linalg.eigvals(solve_scaled(M, S)).real.max(axis=-1)
 

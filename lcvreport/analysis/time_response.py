@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -355,3 +356,221 @@ class TimeResponse:
         """
         from ..plotting.time import plot_time_response
         return plot_time_response(self, signals, ax=ax, **style)
+
+
+@runtime_checkable
+class Response(Protocol):
+    """What every response offers, whatever made it -- the exact response of a linear model
+    (:class:`TimeResponse`) or an integration of any model (:class:`SampledResponse`): signal
+    names, the sample times [s], a signal by name or column header (``r["ay2"]``), their units,
+    extrema located between the samples, a table and a figure."""
+
+    time: np.ndarray
+
+    @property
+    def signal_names(self) -> tuple[str, ...]: ...
+
+    def __getitem__(self, name: str) -> np.ndarray: ...
+
+    def units(self) -> dict: ...
+
+    def extrema(self, name: str, t_from: float = 0.0, t_to: float = math.inf) -> tuple: ...
+
+    def extrema_many(self, names, t_from: float = 0.0, t_to: float = math.inf) -> list: ...
+
+    def to_pandas(self): ...
+
+    def to_rows(self, names=None) -> list: ...
+
+    def plot(self, signals=None, ax=None, **style): ...
+
+
+class SampledResponse:
+    """A response integrated from a model's equations (:func:`lcvreport.analysis.integrate.integrate`):
+    the integrator's dense output over every stretch between the steer's breakpoints, sampled; every
+    signal of the model (:meth:`~lcvreport.model.base.VehicleModel.outputs`) by name with its unit;
+    extrema located on the dense output between the samples (each bracketed by a sign change of
+    the sampled slope and refined on the dense output to 1e-10 s).
+
+    Attributes
+    ----------
+    model : VehicleModel
+    time : numpy.ndarray
+        [s]
+    speed_mps, tire_scale : float
+    label : str
+    """
+
+    def __init__(self, model, time, pieces, speed_mps, tire_scale, delta_of, w0, label=""):
+        self.model, self.time, self.pieces = model, np.asarray(time, dtype=float), pieces
+        self.speed_mps, self.tire_scale, self.label = float(speed_mps), float(tire_scale), label
+        self.vehicle = model.vehicle
+        self._delta_of, self._w0 = delta_of, np.asarray(w0, dtype=float)
+        self._linear = model.kind == "linear"
+        self._table = self._signals_at(self.time)
+
+    # ------------------------------------------------------------------ the dense output
+    def state_at(self, t) -> np.ndarray:
+        """The state at times ``t`` [s] from the dense output, shape (len(t), n)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        out = np.empty((t.size, self.pieces[0][2](self.pieces[0][0]).size))
+        for k, (a, b, sol) in enumerate(self.pieces):
+            last = k == len(self.pieces) - 1
+            sel = (t >= a) & ((t < b) | (last & (t <= b + 1e-12)))
+            if sel.any():
+                out[sel] = sol(t[sel]).T
+        return out
+
+    def _signals_at(self, t) -> dict:
+        """Every signal at the times ``t``: {name: array} (a nonlinear model's outputs of every
+        time in one call: its equations take a batch of states)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        X = self.state_at(t)
+        W = np.tile(self._w0, (t.size, 1))
+        W[:, 0] = [self._delta_of(ti, z) for ti, z in zip(t, X)]
+        if not self._linear:
+            out = self.model.outputs(t, X, W, self.speed_mps, self.tire_scale)
+            return {k: np.asarray(val, dtype=float).reshape(t.size) for k, val in out.items()}
+        rows = [self._outputs(ti, z, w) for ti, z, w in zip(t, X, W)]
+        return {name: np.array([r[name] for r in rows]) for name in rows[0]}
+
+    def _outputs(self, t, z, w) -> dict:
+        m = self.model
+        if not self._linear:
+            return m.outputs(t, z, w, self.speed_mps, self.tire_scale)
+        x, psi1, Y1 = z[:-2], z[-2], z[-1]
+        out = m.outputs(t, x, w, self.speed_mps, self.tire_scale)
+        out["psi1"], out["Y1"] = psi1, Y1
+        zz = np.r_[x, psi1, Y1]
+        v = self.vehicle
+        for i, a in zip(v.axle_units, v.axles):
+            out[f"Y_{a.name}"] = float(m.point_lateral_row(i, a.x_m) @ zz)
+        last = v.n_units - 1
+        out["Y_rear"] = float(m.point_lateral_row(last, v.rear_end_x_m(last)) @ zz)
+        return out
+
+    # ------------------------------------------------------------------ names, values, units
+    @property
+    def signal_names(self) -> tuple[str, ...]:
+        return tuple(self._table)
+
+    def units(self) -> dict:
+        """``{signal: unit}`` (``"m/s^2"``, ``"rad"``, ``"-"``)."""
+        return {n: sampled_unit(n) for n in self.signal_names}
+
+    def columns(self) -> list[str]:
+        return ["time_s"] + [sampled_column(n) for n in self.signal_names]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name == "time_s":
+            return self.time
+        if name in self._table:
+            return self._table[name]
+        for n in self._table:
+            if sampled_column(n) == name:
+                return self._table[n]
+        raise KeyError(f"no signal {name!r}; signals: {', '.join(self.signal_names)}")
+
+    def _name(self, name: str) -> str:
+        if name in self._table:
+            return name
+        for n in self._table:
+            if sampled_column(n) == name:
+                return n
+        raise KeyError(f"no signal {name!r}; signals: {', '.join(self.signal_names)}")
+
+    def value_at(self, name: str, t: float) -> float:
+        """The signal ``name`` at time ``t`` [s] (from the dense output)."""
+        return float(self._signals_at(np.array([float(t)]))[self._name(name)][0])
+
+    def matrix(self) -> np.ndarray:
+        return np.column_stack([self.time] + [self._table[n] for n in self.signal_names])
+
+    def to_rows(self, names=None) -> list[dict]:
+        cols = self.columns()
+        keep = [0] + [i for i, n in enumerate(self.signal_names, start=1) if names is None or n in names
+                      or cols[i] in names]
+        M = self.matrix()
+        return [{cols[i]: float(row[i]) for i in keep} for row in M]
+
+    def to_pandas(self):
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("to_pandas needs pandas: pip install 'lcvreport[study]'") from None
+        return pd.DataFrame(self.matrix(), columns=self.columns())
+
+    # ------------------------------------------------------------------ extrema
+    def extrema(self, name: str, t_from: float = 0.0, t_to: float = math.inf) -> tuple:
+        return self.extrema_many([name], t_from, t_to)[0]
+
+    def extrema_many(self, names, t_from: float = 0.0, t_to: float = math.inf) -> list:
+        """Times [s] and values of every local extremum of each signal in ``[t_from, t_to]``, and
+        the values at the window's ends: each sampled sign change of the slope refined on the dense
+        output (bounded search between the neighbouring samples)."""
+        from scipy.optimize import minimize_scalar
+        t = self.time
+        out = []
+        t_to = min(t_to, float(t[-1]))
+        for name in names:
+            key = self._name(name)
+            y = self._table[key]
+            times, values = [], []
+            for k in range(1, t.size - 1):
+                if not (t_from <= t[k] <= t_to):
+                    continue
+                left, right = y[k] - y[k - 1], y[k + 1] - y[k]
+                if (left > 0 >= right) or (left < 0 <= right):
+                    sign = 1.0 if left > 0 else -1.0
+                    res = minimize_scalar(lambda s: -sign * self.value_at(key, s), bounds=(t[k - 1], t[k + 1]),
+                                          method="bounded", options={"xatol": 1e-10})
+                    tk = float(res.x)
+                    vk = -sign * float(res.fun)
+                    if sign * vk < sign * y[k]:                 # the sample itself is the better one
+                        tk, vk = float(t[k]), float(y[k])
+                    times.append(tk)
+                    values.append(vk)
+            for tb in (t_from, t_to):
+                if t[0] <= tb <= t[-1]:
+                    times.append(float(tb))
+                    values.append(self.value_at(key, tb))
+            order = np.argsort(times)
+            out.append((np.asarray(times)[order], np.asarray(values)[order]))
+        return out
+
+    def peak_abs(self, name: str, t_from: float = 0.0, t_to: float = math.inf) -> float:
+        return float(np.abs(self.extrema(name, t_from, t_to)[1]).max())
+
+    def peaks_abs(self, names, t_from: float = 0.0, t_to: float = math.inf) -> np.ndarray:
+        return np.array([float(np.abs(v).max()) for _t, v in self.extrema_many(names, t_from, t_to)])
+
+    def plot(self, signals=None, ax=None, **style):
+        """Plot signals against time (default every unit's ``ay``)."""
+        from ..plotting.time import plot_time_response
+        return plot_time_response(self, signals, ax=ax, **style)
+
+
+#: the unit of the nonlinear model's signals by their start (first match), beyond the linear ones
+SAMPLED_UNITS = (("X", "m_per_s", "m"), ("Fx_", "N", "N"), ("Fy_", "N", "N"), ("fd_", "", "-"),
+                 ("u1", "m_per_s", "m/s"))
+
+
+def sampled_unit(name: str) -> str:
+    """A sampled signal's unit: the nonlinear model's forces, friction demand and positions, else
+    :func:`signal_unit`."""
+    if name.startswith("X"):
+        return "m"
+    for prefix, _s, unit in SAMPLED_UNITS:
+        if name.startswith(prefix):
+            return unit
+    return signal_unit(name)
+
+
+def sampled_column(name: str) -> str:
+    """A sampled signal's column header (``X2_m``, ``Fy_steer_N``, ``fd_steer``)."""
+    if name.startswith("X"):
+        return f"{name}_m"
+    for prefix, suffix, _u in SAMPLED_UNITS:
+        if name.startswith(prefix) and prefix != "X":
+            return f"{name}_{suffix}" if suffix else name
+    return column(name)

@@ -184,7 +184,7 @@ def vehicle_data_header(itf: Interface) -> str:
         arrays = {"M0": co.M0, "M1": co.M1, "S0": co.S0, "Sinv": co.Sinv, "Su": co.Su, "Skin": co.Skin,
                   "Bdelta": co.Bdelta, "Bw": maps["Bw"], "C": maps["C"], "H": maps["H"], "W": maps["W"],
                   "Bc": co.B_crossfall, **fd}
-        out.append(f"/* {v.name}: {N} units, {n} states ({co.kind}), {fd['FX0'].shape[0]} feedthrough rows */")
+        out.append(f"/* {v.name}: {N} units, {n} states ({co.name}), {fd['FX0'].shape[0]} feedthrough rows */")
         for name, arr in arrays.items():
             out.append(_c_array("double", f"{p}_{name}", arr))
         out.append(_c_array("int", f"{p}_fd_row", maps["fd_row"]))

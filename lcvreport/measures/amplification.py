@@ -25,7 +25,7 @@ import numpy as np
 
 from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ, _freq, steer_to_acceleration
-from ..model.linear import check_speed, check_tire_scale, linear_model
+from ..model.linear import check_speed, check_tire_scale, linear_model, stiffness
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.equations import system_coefficients
 from .registry import MeasureCase
@@ -212,7 +212,7 @@ def _ra_slope(batch: VariantBatch, speed_mps: float, x_hz: np.ndarray, tire_scal
     c = {k: v[rows] for k, v in batch.coefficients.items()}
     u = float(speed_mps)
     M = c["M0"] + u * c["M1"]
-    S = tire_scale * (c["S0"] + c["Sinv"] / u) + c["Skin"] + u * c["Su"]
+    S = stiffness(c, u, tire_scale)
     w = 2 * np.pi * np.asarray(x_hz, dtype=float)
     A = 1j * w[:, None, None] * M - S
     z = np.linalg.solve(A, (tire_scale * c["Bdelta"])[..., None].astype(complex))

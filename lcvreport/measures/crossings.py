@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from ..model.linear import check_tire_scale, linear_model
+from ..model.linear import check_tire_scale, linear_model, stiffness
 from ..model.vehicle import Vehicle
 from ..ranges import RANGES
 from ..units import kph_to_mps, mps_to_kph
@@ -95,7 +95,7 @@ def _polish_all(co, s: float, u: float, tries: int = 4) -> list[float]:
     """The roots Newton reaches from ``u`` [m/s] starting on each of the ``tries`` eigenvalues
     nearest the imaginary axis there (the root QZ gave may sit a few km/h off its crossing, where
     another mode is nearer the axis)."""
-    S = s * (co.S0 + co.Sinv / u) + co.Skin + u * co.Su
+    S = stiffness(co, u, s)
     w = scipy.linalg.eigvals(S, co.M0 + u * co.M1)
     order = np.argsort(np.abs(w.real) / np.maximum(1.0, np.abs(w)))
     out = []
@@ -114,7 +114,7 @@ def _polish(co, s: float, u: float, steps: int = 30, start=None) -> float | None
     for _ in range(steps):
         if not u > 0.0:
             return None
-        S = s * (co.S0 + co.Sinv / u) + co.Skin + u * co.Su
+        S = stiffness(co, u, s)
         M = co.M0 + u * co.M1
         w, vl, vr = scipy.linalg.eig(S, M, left=True, right=True)
         if target is None:                      # the eigenvalue this root makes cross
@@ -123,7 +123,8 @@ def _polish(co, s: float, u: float, steps: int = 30, start=None) -> float | None
             k = int(np.argmin(np.abs(w - target)))
         lam, x, y = w[k], vr[:, k], vl[:, k]
         dS = -s * co.Sinv / u**2 + co.Su
-        dlam = (y.conj() @ (dS - lam * co.M1) @ x) / (y.conj() @ M @ x)
+        with np.errstate(invalid="ignore", divide="ignore"):   # y^H M x = 0: an infinite eigenvalue
+            dlam = (y.conj() @ (dS - lam * co.M1) @ x) / (y.conj() @ M @ x)
         if dlam.real == 0.0 or not np.isfinite(dlam):
             return None
         step = -lam.real / dlam.real
@@ -162,7 +163,7 @@ def max_real(co, s: float, u_mps) -> np.ndarray:
     """``max Re(lambda)`` [1/s] of ``M(u)^-1 S(u, s)`` from the coefficients of ``co`` at the speeds ``u_mps``."""
     u = np.asarray(u_mps, dtype=float)[..., None, None]
     M = co.M0 + u * co.M1
-    S = s * (co.S0 + co.Sinv / u) + co.Skin + u * co.Su
+    S = stiffness(co, u, s)
     return np.linalg.eigvals(solve_scaled(M, S)).real.max(axis=-1)
 
 

@@ -23,8 +23,8 @@ Examples
 --------
 >>> from lcvreport import load_preset
 >>> m = linear_model(load_preset("tractor_semitrailer"))
->>> m.kind, m.n_states, m.state_names
-('yaw_plane', 4, ('v1', 'r1', 'r2', 'thetaA'))
+>>> m.kind, m.name, m.n_states, m.state_names
+('linear', 'yaw_plane', 4, ('v1', 'r1', 'r2', 'thetaA'))
 >>> m.state_units
 ('m/s', 'rad/s', 'rad/s', 'rad')
 >>> linear_model(load_preset("aucnat"), "yaw_plane").M(24.0).shape
@@ -37,8 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..ranges import check_array
 from ..util.numerics import solve_scaled
+from .base import check_speed, check_tire_scale  # noqa: F401  (their home is the model object's module)
 
 #: the linear models: name -> "module:builder" (relative to this package); the builder takes
 #: (vehicle, units) and returns a LinearModel
@@ -79,24 +79,63 @@ def linear_model(vehicle, model: str = "yaw_plane", units=None) -> "LinearModel"
     return build(vehicle) if units is None else build(vehicle, units)
 
 
-def check_speed(speed_mps, name: str = "speed") -> np.ndarray:
-    """Raise :class:`lcvreport.ranges.RangeError` unless every speed [m/s] is in range."""
-    return check_array("speed", speed_mps, name)
-
-
-def check_tire_scale(tire_scale, name: str = "tire_scale") -> np.ndarray:
-    """Raise :class:`lcvreport.ranges.RangeError` unless every tire scale is in range."""
-    return check_array("tire_scale", tire_scale, name)
+def stiffness(coefficients, speed_mps, tire_scale=1.0):
+    """``S(u, s) = s (S0 + Sinv / u) + Skin + u Su`` of any holder of the coefficients -- a
+    :class:`LinearModel`, or a batch's arrays with a leading variant axis (a mapping or an object
+    with ``S0, Sinv, Skin, Su``) -- broadcasting ``speed_mps`` [m/s] and ``tire_scale`` against
+    the coefficients' leading axes (the one place the formula is written)."""
+    get = coefficients.__getitem__ if isinstance(coefficients, dict) else lambda k: getattr(coefficients, k)
+    u, s = speed_mps, tire_scale
+    return s * (get("S0") + get("Sinv") / u) + get("Skin") + u * get("Su")
 
 
 class LinearModel:
-    """The interface of a linear model (see the module docstring).  Subclasses are frozen
+    """The interface of a linear model (see the module docstring), a
+    :class:`~lcvreport.model.base.VehicleModel` of kind ``"linear"``.  Subclasses are frozen
     dataclasses holding ``vehicle``, ``units`` and the coefficients ``M0, M1, S0, Sinv, Su, Skin``
     (n, n), ``Bdelta`` (n,), ``B_P, B_T, B_eps`` (n, n_axles), ``B_crossfall`` (n,), and define
-    :attr:`kind`, :attr:`state_names`, :attr:`state_units`, :meth:`velocity_map`,
+    :attr:`name`, :attr:`state_names`, :attr:`state_units`, :meth:`velocity_map`,
     :meth:`yaw_rate_map` and :meth:`point_lateral_map`."""
 
     kind = "linear"
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        """``delta`` [rad], every axle's ``P_<axle>`` [N], ``T_<axle>`` [N m], ``eps_<axle>``
+        [rad], and ``a_crossfall`` [m/s^2] (g sin(atan(c/100))): the columns of
+        :meth:`input_matrix_full` (the nonlinear model's inputs, the same)."""
+        names = self.vehicle.axle_names
+        return ("delta", *(f"P_{a}" for a in names), *(f"T_{a}" for a in names), *(f"eps_{a}" for a in names),
+                "a_crossfall")
+
+    def input_matrix_full(self, tire_scale: float = 1.0) -> np.ndarray:
+        """B over every input of :attr:`input_names` (SI): the steer's and the misalignments'
+        scale with the tire coefficients, P, T and the crossfall do not."""
+        g = 9.80665 / self.units.length_m                # standard gravity in the unit system
+        return np.column_stack([self.B_delta(tire_scale), self.B_P, self.B_T, tire_scale * self.B_eps,
+                                self.B_crossfall / g])
+
+    def derivatives(self, t: float, x: np.ndarray, w: np.ndarray, speed_mps: float,
+                    tire_scale: float = 1.0) -> np.ndarray:
+        """``x' = M(u)^-1 (S(u, s) x + B w)`` [SI] (``w`` over :attr:`input_names`)."""
+        A, G = self.state_derivative_maps(speed_mps, tire_scale)
+        return A @ np.asarray(x, dtype=float) + G @ (self.input_matrix_full(tire_scale) @ np.asarray(w, dtype=float))
+
+    def outputs(self, t: float, x: np.ndarray, w: np.ndarray, speed_mps: float, tire_scale: float = 1.0) -> dict:
+        """The states by name, ``delta`` and every unit's lateral acceleration ``ay<i> = v_i' + u r_i``
+        [SI] at one instant."""
+        x = np.asarray(x, dtype=float)
+        xd = self.derivatives(t, x, w, speed_mps, tire_scale)
+        u = float(self.units.speed(float(speed_mps)))
+        a = self.velocity_map(speed_mps) @ xd + u * (self.yaw_rate_map() @ x)
+        out = dict(zip(self.state_names, x.tolist()))
+        out["delta"] = float(np.asarray(w)[0])
+        out.update({f"ay{i + 1}": float(ai) for i, ai in enumerate(a)})
+        return out
+
+    def linearize(self, speed_mps: float = None, tire_scale: float = 1.0) -> "LinearModel":
+        """A linear model is its own linearization."""
+        return self
 
     @property
     def n_states(self) -> int:
@@ -120,9 +159,7 @@ class LinearModel:
 
     def S(self, speed_mps: float | np.ndarray, tire_scale: float | np.ndarray = 1.0) -> np.ndarray:
         """Stiffness matrix at forward speed [m/s] and tire scale [-]; broadcasts."""
-        u = self._u(speed_mps)
-        s = np.asarray(tire_scale, dtype=float)[..., None, None]
-        return s * (self.S0 + self.Sinv / u) + self.Skin + u * self.Su
+        return stiffness(self, self._u(speed_mps), np.asarray(tire_scale, dtype=float)[..., None, None])
 
     def B_delta(self, tire_scale: float | np.ndarray = 1.0) -> np.ndarray:
         """Generalized force per radian of steer angle (force and moment units per rad)."""

@@ -138,6 +138,10 @@ class Axle:
         mass relative to the axle; roll only (docs/roll.md).
     unsprung_mass_kg : float or None
         The axle's unsprung mass [kg], >= 0, part of its unit's ``mass_kg``; roll only.
+    driven : bool or None
+        The axle drives (first unit only): the nonlinear model's driven axles share the
+        longitudinal force that holds unit 1's speed (docs/nonlinear.md); None: the default, every
+        non-steered axle of unit 1.
     """
 
     name: str
@@ -153,9 +157,12 @@ class Axle:
     roll_stiffness_Nm_per_rad: float | None = None
     roll_damping_Nms_per_rad: float | None = None
     unsprung_mass_kg: float | None = None
+    driven: bool | None = None
 
     def __post_init__(self):
         _name("name", self.name, AXLE_NAME, "a name of letters, digits and _")
+        if self.driven is not None and not isinstance(self.driven, bool):
+            raise VehicleError("driven", f"driven must be true or false, got {self.driven!r}")
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
         set_("x_m", _number("x_m", self.x_m, "position_m"))
         if isinstance(self.tires, bool) or not isinstance(self.tires, Integral) or not 1 <= self.tires <= 64:
@@ -401,6 +408,9 @@ class Vehicle:
                 if a.steered and i > 0:
                     raise VehicleError("steered", "steered axles must be on the first unit (the steer "
                                        "input acts on the towing unit)", awhere)
+                if a.driven and i > 0:
+                    raise VehicleError("driven", "driven axles must be on the first unit (it hauls the "
+                                       "combination)", awhere)
 
     # ------------------------------------------------------------------ chain
     @property

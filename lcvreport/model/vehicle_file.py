@@ -84,7 +84,7 @@ UNIT_KEYS = (("name", "mass_kg", "yaw_inertia_kg_m2", "axles"),
              ("front_coupling_m", "rear_coupling_m", "rear_end_m", "body_front_m", "body_rear_m",
               "body_width_m") + UNIT_ROLL_KEYS)
 AXLE_KEYS = (("name", "x_m", "tires", "cornering_stiffness_N_per_rad", "aligning_stiffness_Nm_per_rad",
-              "longitudinal_stiffness_N", "dual_spacing_m"), ("steered", "static_load_N", "track_width_m")
+              "longitudinal_stiffness_N", "dual_spacing_m"), ("steered", "driven", "static_load_N", "track_width_m")
              + AXLE_ROLL_KEYS)
 
 
@@ -299,7 +299,7 @@ def dumps_vehicle(vehicle: Vehicle, header: str = "", unit_comments: dict | None
             for key in AXLE_KEYS[0] + AXLE_KEYS[1]:
                 value = getattr(a, key)
                 if key == "steered" and not value:
-                    continue
+                    continue                           # (driven: written when given, None when not)
                 if value is not None:
                     out.append(f"  {key} = {_value(value)}")
     return "\n".join(out) + "\n"

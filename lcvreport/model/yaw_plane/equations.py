@@ -82,7 +82,7 @@ class SystemCoefficients(LinearCoefficients):
     B_eps: np.ndarray = None
     B_crossfall: np.ndarray = None
 
-    kind = "yaw_plane"
+    name = "yaw_plane"
 
     def velocity_map(self, speed_mps: float) -> np.ndarray:
         """``V`` with ``v = V x``: the CG lateral velocity of every unit [length/s] from the

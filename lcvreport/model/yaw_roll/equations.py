@@ -72,7 +72,7 @@ class YawRollCoefficients(LinearCoefficients):
     roll_stiffness: np.ndarray
     roll: RollParameters
 
-    kind = "yaw_roll"
+    name = "yaw_roll"
 
     @property
     def _n(self) -> int:

@@ -1,0 +1,1 @@
+"""The nonlinear planar model (docs/nonlinear.md): any angle, saturating tires."""
