@@ -60,6 +60,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``extrema``          extrema between samples (Hermite), the doubling scan
     ``time_response``    the Response protocol; TimeResponse (exact) and SampledResponse (integrated): signals, extrema, plot
     ``integrate``        one implicit integration of any model (Radau), restarted at the steer's breakpoints
+    ``respond``          the response of any model: a linear one's exact, any other's integrated
     ``response``         simulate, step_response: inputs held over intervals (exact)
     ``discretize``       exact zero-order-hold discretization, its cache
     ``modal``            modal superposition, exact and the thesis' method
@@ -74,6 +75,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``yaw_damping``      yaw damping coefficient (ratio method)
     ``offtracking``      HSTO and RA of the lane change, HSSO
     ``low_speed``        the low-speed 90-degree turn: swept width, offtracking, tail and frontal swing
+    ``friction_demand``  the turn with tire forces (nonlinear model, path-following law): STFD, drive-tyre demand
     ``rollover``         the static rollover threshold: quasi-static, lift-off axle by axle, exact events
     ``roll``             the roll measures: LTR, roll gains, the yaw-roll model's RA, HSTO, damping
     ``measure_set``      every measure of a vehicle at a speed (MeasureSet)

@@ -170,6 +170,12 @@ RANGES: dict[str, Range] = dict([
     ("turn_angle", Range("turn angle", "deg", 0.0, 3600.0, low_open=True,
                          description="angle of the low-speed turn (ten laps at most)")),
     ("payload", Range("payload", "kg", 0.0, 1e5, description="a payload added to one unit in a study")),
+    ("friction", Range("friction coefficient", "1", 0.0, 2.0, low_open=True,
+                       description="tire-road friction coefficient mu of the nonlinear model")),
+    ("path_gain", Range("path gain", "rad/m", 0.0, 20.0, low_open=True,
+                        description="steer per metre of path error in the nonlinear model's low-speed turn")),
+    ("turn_speed", Range("turn speed", "km/h", 0.0, 30.0, low_open=True,
+                         description="unit 1's speed in the nonlinear model's low-speed turn")),
 ])
 
 #: vehicle-file limits (SI, per tire where the file is per tire)

@@ -240,7 +240,9 @@ SPEC_KEYS = {"speed_mps", "least_damping_ratio", "least_damped_frequency_hz", "c
              "ra_single_sine_roll", "ltr_single_sine", "ra_lane_change_roll", "hsto_m_roll", "ltr_lane_change",
              "rltr_lane_change", "roll_gain_deg_per_g",
              # the assessment's measures (docs/measures.md): yaw-rate RA, tracking on a straight path
-             "ra_yaw_rate_single_sine", "tasp_m", "hsto_driver_m", "ra_lane_change_driver"}
+             "ra_yaw_rate_single_sine", "tasp_m", "hsto_driver_m", "ra_lane_change_driver",
+             # SPEC 18: the friction demand of the turn with tire forces (on request: null, with the reason)
+             "stfd", "friction_demand_drive", "path_error_max_m"}
 
 
 @pytest.mark.parametrize("source", [["--preset", "aucnat"]] + [["--vehicle", str(EXAMPLES / f"{n}.toml")]

@@ -49,7 +49,7 @@ def test_every_family_is_registered_once_and_its_functions_exist():
         if f.batched:
             assert callable(_resolve(f.batched)), f.batched
             assert BATCHED[f.name] == f.batched_keys
-        assert f.model in ("yaw_plane", "low_speed", "yaw_roll")
+        assert f.model in ("yaw_plane", "low_speed", "yaw_roll", "nonlinear")
         assert f.needs in ("", "steer", "sources", "geometry")
 
 

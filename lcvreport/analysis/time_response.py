@@ -408,6 +408,10 @@ class SampledResponse:
         self._delta_of, self._w0 = delta_of, np.asarray(w0, dtype=float)
         self._linear = model.kind == "linear"
         self._table = self._signals_at(self.time)
+        #: the time [s] the run's stop condition ended it, or None (:func:`~lcvreport.analysis.integrate.integrate`)
+        self.stopped_at = None
+        #: how many evaluations of the model's equations the run took
+        self.evaluations = 0
 
     # ------------------------------------------------------------------ the dense output
     def state_at(self, t) -> np.ndarray:
@@ -427,7 +431,10 @@ class SampledResponse:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         X = self.state_at(t)
         W = np.tile(self._w0, (t.size, 1))
-        W[:, 0] = [self._delta_of(ti, z) for ti, z in zip(t, X)]
+        if getattr(self._delta_of, "vectorized", False):
+            W[:, 0] = self._delta_of(t, X.T)
+        else:
+            W[:, 0] = [self._delta_of(ti, z) for ti, z in zip(t, X)]
         if not self._linear:
             out = self.model.outputs(t, X, W, self.speed_mps, self.tire_scale)
             return {k: np.asarray(val, dtype=float).reshape(t.size) for k, val in out.items()}

@@ -151,7 +151,11 @@ def build_parser() -> argparse.ArgumentParser:
                           "driver, gain K rad/m, preview T s); default none")
     sim.add_argument("--t-end", default=10.0, type=_ranged("t_end", what="end time in s"), metavar="T",
                      help=f"end time [s], in {_help_range('t_end')}; default 10")
-    sim.add_argument("--model", default="yaw-plane", choices=("yaw-plane", "yaw-roll"),
+    sim.add_argument("--tire", choices=("saturating", "linear"), default=None,
+                     help="the nonlinear model's tire law (default saturating: the brush tire)")
+    sim.add_argument("--friction-coefficient", type=_ranged("friction", what="friction coefficient mu"),
+                     metavar="MU", default=None, help="the nonlinear model's mu, in (0, 2]; default 0.8")
+    sim.add_argument("--model", default="yaw-plane", choices=("yaw-plane", "yaw-roll", "nonlinear"),
                      help="the linear model: yaw-plane (default) or yaw-roll (adds roll rates, roll angles, sprung "
                           "CG accelerations, axle load transfers and load transfer ratios; needs the roll keys)")
     sim.add_argument("--dt", default=0.01, type=_ranged("output_step", what="output step in s"), metavar="H",
@@ -243,6 +247,17 @@ def build_parser() -> argparse.ArgumentParser:
     turn.add_argument("--angle-deg", type=_ranged("turn_angle", what="turn angle in deg"), default=90.0, metavar="A",
                       help=f"angle of the turn [deg], in {_help_range('turn_angle')}; default 90")
     turn.add_argument("--plot", metavar="FILE", help="draw the swept path into FILE (.png, .pdf or .svg; a new file)")
+    turn.add_argument("--model", default="kinematic", choices=("kinematic", "nonlinear"),
+                      help="the kinematic model (default: no forces) or the nonlinear model with tire forces "
+                           "(friction demand, docs/nonlinear.md)")
+    turn.add_argument("--speed-kph", type=_ranged("speed", factor=3.6, unit="km/h", what="turn speed in km/h"),
+                      default=None, metavar="V", help="with --model nonlinear: unit 1's speed [km/h]; default 5")
+    turn.add_argument("--friction-coefficient", type=_ranged("friction", what="friction coefficient mu"),
+                      metavar="MU", default=None, help="with --model nonlinear: mu, in (0, 2]; default 0.8")
+    turn.add_argument("--path-gain", type=_ranged("path_gain", what="path gain in rad/m"), metavar="K",
+                      default=None, help="with --model nonlinear: the path-following law's gain [rad/m]; default 2 (and its integral term, docs/nonlinear.md)")
+    turn.add_argument("--tire", choices=("saturating", "linear"), default=None,
+                      help="with --model nonlinear: the tire law; default saturating")
     turn.add_argument("--json", action="store_true", help="machine-readable output")
     st = sub.add_parser("study", help="a study file's cases (factors, design, measures) in batches on Dask, "
                                       "results in Parquet")

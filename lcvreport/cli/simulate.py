@@ -6,9 +6,10 @@ import math
 
 import numpy as np
 
-from ..model.linear import check_model, linear_model
+from ..model.base import MODELS, check_model
+from ..model.linear import linear_model
 from ..ranges import RANGES, RangeError
-from .options import UsageError, _one_percent_vector, _sources, _speed_mps, _vehicle
+from .options import UsageError, _line, _one_percent_vector, _sources, _speed_mps, _vehicle
 from .output import _finite, _Out
 
 
@@ -33,10 +34,14 @@ def _cmd_simulate(args, out: _Out) -> int:
         raise UsageError(f"argument --steer: {exc}") from None
     if args.steer is not None and not v.steered_axles:
         raise UsageError(f"argument --steer: {v.name} has no steered axle")
-    model = check_model(args.model)
+    model = check_model(args.model, MODELS)
     if model == "yaw_roll":
         from .roll import roll_vehicle
         roll_vehicle(args)                      # the roll keys, checked: one line naming what is missing
+    if model == "nonlinear":
+        return _simulate_nonlinear(args, out, v, steer, steps)
+    if args.tire is not None or args.friction_coefficient is not None:
+        raise UsageError("arguments --tire/--friction-coefficient: the nonlinear model's (--model nonlinear)")
     axle_force = np.zeros(len(v.axles))
     if args.load is not None:
         F, axle_force = _one_percent_vector(args, v, model=model)
@@ -81,4 +86,41 @@ def _cmd_simulate(args, out: _Out) -> int:
         k += n
     if args.json:
         out.line("]}")
+    return 0
+
+
+def _simulate_nonlinear(args, out: _Out, v, steer, steps: int) -> int:
+    """``lcv simulate --model nonlinear``: the nonlinear model integrated (docs/nonlinear.md), the
+    columns of its outputs; a lane change of the inverse system is a linear model's (refused)."""
+    from ..analysis.integrate import IntegrationError, integrate
+    from ..model.base import build_model
+    from ..model.vehicle import VehicleError
+    if args.load is not None:
+        raise UsageError("argument --load: the 1 %% rule is a linear model's load case; give --residual AXLE=P,T")
+    try:
+        m = build_model(v, "nonlinear", tire=args.tire or "saturating",
+                        friction_coefficient=0.8 if args.friction_coefficient is None else args.friction_coefficient)
+    except (VehicleError, ValueError) as exc:
+        raise UsageError(f"argument --model nonlinear: {_line(exc)}") from None
+    try:
+        src = _sources(args, v)
+        src.vector(v, args.tire_scale)                    # each source checked against the vehicle
+    except (KeyError, RangeError) as exc:
+        raise UsageError(f"argument: {exc.args[0]}") from None
+    try:
+        r = integrate(m, steer, _speed_mps(args), steps * args.dt, args.dt, args.tire_scale,
+                      sources=src if src else None)
+    except IntegrationError as exc:
+        raise UsageError(f"argument --steer: {_line(exc)}") from None
+    M = r.matrix() + 0.0                                  # no -0 printed
+    _finite(M)
+    names = r.columns()
+    if args.json:
+        out.write('{"columns": ' + json.dumps(names) + ', "rows": [')
+        out.write(", ".join(json.dumps(row) for row in M.tolist()))
+        out.line("]}")
+        return 0
+    out.line(",".join(names))
+    row_format = ",".join(["%.10g"] * M.shape[1]) + "\n"
+    out.write("".join([row_format % tuple(row) for row in M.tolist()]))
     return 0

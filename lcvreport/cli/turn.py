@@ -10,6 +10,11 @@ def _cmd_turn(args, out: _Out) -> int:
     from ..model.body import TurnError
     v = _vehicle(args)
     plot = _plot_path(args)
+    if args.model == "nonlinear":
+        return _turn_nonlinear(args, out, v, plot)
+    for name in ("speed_kph", "friction_coefficient", "path_gain", "tire"):
+        if getattr(args, name) is not None:
+            raise UsageError(f"argument --{name.replace('_', '-')}: the nonlinear model's turn (--model nonlinear)")
     try:
         t = low_speed_turn(v, args.radius, args.angle_deg)
     except TurnError as exc:
@@ -32,6 +37,49 @@ def _cmd_turn(args, out: _Out) -> int:
         out.line(f"  tail swing, {name:<13} {val:8.3f} m")
     if not t.tail_swing_m:
         out.line(f"  {'tail swing':<25} not computed: {_line(t.undefined.get('max_tail_swing_m', ''))}")
+    if plot is not None:
+        out.line(f"wrote {plot}")
+    return 0
+
+
+def _turn_nonlinear(args, out: _Out, v, plot) -> int:
+    """``lcv turn --model nonlinear``: the turn with tire forces, friction demand per axle."""
+    from ..analysis.integrate import IntegrationError
+    from ..measures.friction_demand import (PATH_GAIN_RAD_PER_M, TURN_SPEED_KPH, turn_with_tire_forces)
+    from ..model.body import TurnError
+    from ..model.nonlinear.model import FRICTION_COEFFICIENT
+    from ..model.vehicle import VehicleError
+    try:
+        t = turn_with_tire_forces(v, args.radius, args.angle_deg,
+                                  TURN_SPEED_KPH if args.speed_kph is None else args.speed_kph,
+                                  FRICTION_COEFFICIENT if args.friction_coefficient is None else args.friction_coefficient,
+                                  PATH_GAIN_RAD_PER_M if args.path_gain is None else args.path_gain,
+                                  tire=args.tire or "saturating")
+    except (TurnError, VehicleError, ValueError) as exc:
+        raise UsageError(f"argument --{'vehicle' if args.vehicle else 'preset'}: {_line(exc)}") from None
+    except IntegrationError as exc:
+        raise UsageError(f"argument --speed-kph: {_line(exc)}") from None
+    if plot is not None:
+        _write_figure_new(t.plot(), plot)
+    if args.json:
+        out.json(t.to_dict())
+        return 0
+    out.line(f"{v.name}: low-speed {t.angle_deg:g} deg turn with tire forces ({t.tire} tires, mu {t.friction_coefficient:g},"
+             f" {t.speed_kph:g} km/h), outside steer wheel on R = {t.radius_m:g} m, path gain "
+             f"{t.path_gain_rad_per_m:g} rad/m")
+    out.line(f"  path error, largest            {t.path_error_max_m:8.4f} m")
+    for label, key, value in (("steer-tyre friction demand", "stfd", t.stfd),
+                              ("drive-tyre friction demand", "friction_demand_drive", t.friction_demand_drive)):
+        out.line(f"  {label:<30} {value:8.3f}" if value is not None else
+                 f"  {label:<30} not computed: {_line(t.undefined.get(key, ''))}")
+    for axle, fd in t.friction_demand.items():
+        out.line(f"  friction demand, axle {axle:<9} {fd:8.3f}")
+    for label, key in (("swept width (lssp)", "lssp_m"), ("low-speed offtracking", "low_speed_offtracking_m"),
+                       ("frontal swing", "frontal_swing_m"), ("tail swing, largest", "max_tail_swing_m")):
+        mine = None if t.turn is None else getattr(t.turn, key)
+        kin = getattr(t.kinematic, key)
+        text = "not computed" if mine is None else f"{mine:8.3f} m"
+        out.line(f"  {label:<30} {text}  (kinematic: {'not computed' if kin is None else f'{kin:.3f} m'})")
     if plot is not None:
         out.line(f"wrote {plot}")
     return 0

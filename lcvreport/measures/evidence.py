@@ -24,7 +24,8 @@ from .registry import CONDITIONS, MEASURES
 
 #: what each family's evidence is
 KINDS = {"lane_change": "lane_change", "single_sine": "single_sine", "yaw_damping": "pulse",
-         "low_speed_turn": "swept_path", "rollover": "tilt", "straight_path": "straight_path"}
+         "low_speed_turn": "swept_path", "rollover": "tilt", "straight_path": "straight_path",
+         "friction_demand": "friction_demand"}
 #: the roll family's measures read from its lane change, and from its single sine
 ROLL_LANE_CHANGE = ("ra_lane_change_roll", "hsto_m_roll", "rltr_lane_change")
 ROLL_SINGLE_SINE = ("ra_single_sine_roll",)
@@ -33,7 +34,7 @@ ROLL_SINGLE_SINE = ("ra_single_sine_roll",)
 @dataclass(frozen=True)
 class Evidence:
     """What one measure was read from: ``kind`` (``lane_change``, ``single_sine``, ``pulse``,
-    ``swept_path``, ``tilt``, ``straight_path``; ``value`` for a measure drawn as its value
+    ``swept_path``, ``tilt``, ``straight_path``, ``friction_demand`` (the turn with tire forces); ``value`` for a measure drawn as its value
     against the limits), the ``result`` object (None for ``value``), the ``verdict`` and the
     scheme's ``levels``.  ``plot()`` draws it with the limits on it."""
 
@@ -94,6 +95,12 @@ def evidence(assessment, verdict) -> Evidence:
     if family == "low_speed_turn":
         from .low_speed import low_speed_turn
         return Evidence("swept_path", low_speed_turn(v, c["turn_radius_m"], c["turn_angle_deg"]), verdict, levels)
+    if family == "friction_demand":
+        from .friction_demand import turn_with_tire_forces
+        turn = turn_with_tire_forces(v, *(c.get(k, CONDITIONS[k].default) for k in (
+            "turn_radius_m", "turn_angle_deg", "turn_speed_kph", "friction_coefficient", "path_gain_rad_per_m")),
+            tire_scale=s)
+        return Evidence("friction_demand", turn, verdict, levels, "nonlinear")
     if family == "rollover":
         from .rollover import rollover_threshold
         return Evidence("tilt", rollover_threshold(v), verdict, levels, "yaw_roll")

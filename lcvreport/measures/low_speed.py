@@ -55,6 +55,7 @@ from ..manoeuvres.paths import StraightArcPath
 from ..model.body import TurnError, _need_bodies, _need_tracks, corners, overall_length_m
 from ..model.low_speed.kinematics import KinematicRun, KinematicsError, integrate
 from ..model.vehicle import Vehicle
+from ..util.cache import memoized
 from .registry import MeasureCase
 
 
@@ -169,7 +170,7 @@ class LowSpeedTurn:
         body corner, side and wheel, sampled along the path; a turn past 360 degrees is folded
         onto one lap.  What the swept-path figure draws (the drawing computes nothing)."""
         v, run = self.vehicle, self.run
-        s = np.linspace(0.0, run.path.s_end, 1500 + int(run.path.s_end / 0.5))
+        s = np.linspace(0.0, run.s_end, 1500 + int(run.s_end / 0.5))
         centre = run.path.centre
         angle = math.radians(self.angle_deg)
         edges = np.linspace(0.0, min(angle, 2 * math.pi), bins + 1)
@@ -221,7 +222,7 @@ class LowSpeedTurn:
             if self.frontal_swing_m is None:
                 return {}
             u = v.units[0]
-            s = np.linspace(0.0, run.path.s_end, 1500)
+            s = np.linspace(0.0, run.s_end, 1500)
             pts = run.unit_points(s, 0, [u.body_front_m], [-u.body_width_m / 2])[:, 0]
             at = run.unit_points(np.array([self.where["frontal_swing_s"]]), 0, [u.body_front_m],
                                  [-u.body_width_m / 2])[0, 0]
@@ -319,9 +320,12 @@ def _extreme(probe: _Probe, value, sign: float, s: np.ndarray, centre: np.ndarra
     return best
 
 
+@memoized(32)
 def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
                    rtol: float = 1e-10, atol: float = 1e-12) -> LowSpeedTurn:
-    """The low-speed turn of ``vehicle`` and its measures (docs/low_speed_turn.md).
+    """The low-speed turn of ``vehicle`` and its measures (docs/low_speed_turn.md); computed
+    once per vehicle and turn (cached: the measures, the evidence and the turn with tire forces
+    read the same run).
 
     Parameters
     ----------
@@ -363,13 +367,25 @@ def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: floa
     if not radius_m > half_track:
         raise TurnError(f"radius must be in ({half_track:g}, 100] m (the outside wheel of axle {steer.name} is "
                         f"{half_track:g} m from its centre), got {radius_m!r}")
+    path = StraightArcPath(radius_m, math.radians(angle_deg), EXIT_LENGTHS * overall_length_m(vehicle))          # the outside wheel's path
+    run = integrate(vehicle, path, np.zeros(vehicle.n_units), rtol, atol, pull_offset_m=-half_track)
+    return turn_of_run(vehicle, run, radius_m, angle_deg)
+
+
+def turn_of_run(vehicle: Vehicle, run, radius_m: float, angle_deg: float) -> LowSpeedTurn:
+    """The low-speed turn's measures of ``vehicle`` on the poses of ``run`` -- the kinematic
+    model's, or any run with its interface (``path``, ``s_end``, ``headings(s)``,
+    ``unit_points(s, k, x, y)`` in the kinematic frame: X forward, Y left, headings
+    counter-clockwise; s the outside steer wheel's arc length): the nonlinear model's turn gives
+    its own poses here (:mod:`lcvreport.measures.friction_demand`)."""
+    u1 = vehicle.units[0]
+    steer = max((a for a in u1.axles if a.steered), key=lambda a: a.x_m)
     length = overall_length_m(vehicle)
     angle = math.radians(angle_deg)
-    path = StraightArcPath(radius_m, angle, EXIT_LENGTHS * length)          # the outside wheel's path
-    run = integrate(vehicle, path, np.zeros(vehicle.n_units), rtol, atol, pull_offset_m=-half_track)
+    path = run.path
     centre = path.centre
-    n_s = max(int(math.ceil(path.s_end / SAMPLE_M)), 200) + 1
-    s = np.linspace(0.0, path.s_end, n_s)
+    n_s = max(int(math.ceil(run.s_end / SAMPLE_M)), 200) + 1
+    s = np.linspace(0.0, run.s_end, n_s)
     if vehicle.n_units > 1:                      # a jackknife: the turn is beyond the vehicle
         art = np.abs(np.diff(run.headings(s), axis=1))
         k, j = np.unravel_index(int(np.argmax(art)), art.shape)

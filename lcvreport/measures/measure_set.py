@@ -13,7 +13,7 @@ Examples
 >>> from lcvreport.units import kph_to_mps
 >>> m = measure_set(load_preset("aucnat"), kph_to_mps(88.0), load_units=["trailer2", "trailer3"])
 >>> sorted(m.to_dict())[:5]
-['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m', 'hsto_driver_m']
+['ay_gain_per_unit', 'critical_speed_kph', 'friction_demand_drive', 'frontal_swing_m', 'hsso_m']
 """
 from __future__ import annotations
 
@@ -29,7 +29,7 @@ from ..model.vehicle import Vehicle, check_vehicle
 from ..model.yaw_plane.loads import load_vector, one_percent_rule
 from ..units import mps_to_kph
 from ..util.threads import one_blas_thread
-from .registry import CONDITIONS, FAMILIES, MEASURES, MeasureCase
+from .registry import CONDITIONS, FAMILIES, MEASURES, ON_REQUEST, MeasureCase
 
 
 @dataclass(frozen=True)
@@ -189,7 +189,7 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     >>> from lcvreport import load_preset
     >>> m = measure_set(load_preset("tractor_semitrailer"), 24.4444)
     >>> sorted(m.to_dict())[:4]
-    ['ay_gain_per_unit', 'critical_speed_kph', 'frontal_swing_m', 'hsso_m']
+    ['ay_gain_per_unit', 'critical_speed_kph', 'friction_demand_drive', 'frontal_swing_m']
     >>> round(m.hsso_m, 4) == round(m.values["hsso_m"], 4)
     True
     """
@@ -202,7 +202,10 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     # each family keeps only its numbers: a manoeuvre's response (up to a megabyte of samples) is
     # freed before the next one is computed (a smaller heap, which malloc does not hand back)
     for family in FAMILIES.values():
-        if family.applies(case):
+        if family.on_request:
+            values.update(dict.fromkeys(family.keys))
+            undefined.update(dict.fromkeys(family.keys, ON_REQUEST))
+        elif family.applies(case):
             v, why = family.compute(case)
             values.update(v)
             undefined.update(why)

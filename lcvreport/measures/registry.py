@@ -49,6 +49,9 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:                                # annotations only: the registry imports no model
     from ..model.vehicle import Vehicle
 
+#: why a measure computed on request is null in a measure set that did not ask for it
+ON_REQUEST = ("computed on request (it takes seconds): lcv measures --model nonlinear, a scheme or a study that "
+              "names it, or measure_values with its key")
 #: why a family whose equations are singular for the vehicle is null
 NO_STEADY_STATE = ("undefined: its equations have no solution for this vehicle (singular: a unit whose tires cannot "
                    "hold both its lateral force and its yaw moment, such as a rigid unit on one axle)")
@@ -108,6 +111,9 @@ class Family:
     needs: str = ""
     #: the conditions it depends on (:data:`CONDITIONS` keys, ``speed_kph`` first if any)
     conditions: tuple = ()
+    #: computed only when asked for (by key, a scheme, a study, its model's ``lcv measures``), not in
+    #: every measure set: the nonlinear model's turn takes seconds
+    on_request: bool = False
 
     @property
     def keys(self) -> tuple[str, ...]:

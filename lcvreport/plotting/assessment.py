@@ -1,5 +1,6 @@
 """The evidence of an assessment drawn with every level's limit on it: the manoeuvre's time
-history, the turn's swept path, the tilt curve, or the value against the limits
+history, the turn's swept path, the friction demand of every axle over the turn with tire
+forces above both models' swept paths, the tilt curve, or the value against the limits
 (:class:`lcvreport.measures.evidence.Evidence`)."""
 from __future__ import annotations
 
@@ -69,6 +70,14 @@ def fig_evidence(ev) -> Figure:
         from .low_speed import fig_swept_path
         fig = fig_swept_path(ev.result, _title(ev))
         _text_box(fig.axes[0], ev)
+        return fig
+    if ev.kind == "friction_demand":
+        from .low_speed import fig_friction_demand_evidence
+        limits = [(f"{levels} limit ({kind})", b) for levels, b, kind in _limits(ev)]
+        # a limit on the path error is no friction demand: drawn as text, not on the demand's axis
+        fig = fig_friction_demand_evidence(ev.result, limits if key != "path_error_max_m" else [], _title(ev))
+        if key == "path_error_max_m":
+            _text_box(fig.axes[1], ev)
         return fig
     if ev.kind == "tilt":
         from .roll import plot_rollover

@@ -133,3 +133,123 @@ def fig_swing(swing: dict, which: str, title: str, limits=()) -> Figure:
     fig.suptitle(title, fontsize=8)
     fig.lcv_data = [{"X_m": float(x), "Y_m": float(y)} for x, y in pts]
     return fig
+
+
+def draw_friction_demand(ax, turn, levels=()) -> dict:
+    """Every axle's friction demand over the turn with tire forces against unit 1's distance
+    travelled [m] on ``ax``, the steered and driven axles drawn heavier, STFD and FDDT marked at
+    their peaks, each of ``levels`` ((label, value) pairs) drawn as a line; the drawn data as
+    columns (``distance_m``, ``fd_<axle>``)."""
+    from ..model.nonlinear.model import driven_axles
+    from .style import LEVEL_STYLES, plain
+    v, r = turn.vehicle, turn.response
+    dist = r.time * turn.speed_kph / 3.6
+    steered = {a.name for a in v.units[0].axles if a.steered}
+    driven = {a.name for a, d in zip(v.axles, driven_axles(v)) if d}
+    rows = {"distance_m": dist}
+    for j, a in enumerate(v.axles):
+        fd = np.asarray(r[f"fd_{a.name}"], dtype=float)
+        rows[f"fd_{a.name}"] = fd
+        role = " (steered)" if a.name in steered else " (driven)" if a.name in driven else ""
+        ax.plot(dist, fd, color=PALETTE[j % len(PALETTE)], lw=1.5 if role else 0.8, label=plain(f"axle {a.name}{role}"))
+    for i, (label, value) in enumerate(levels):
+        ax.axhline(value, color="black", ls=LEVEL_STYLES[i % len(LEVEL_STYLES)], lw=0.9,
+                   label=plain(f"{label}: {value:.4g}"))
+    for key, value, names in (("STFD", turn.stfd, steered), ("FDDT", turn.friction_demand_drive, driven)):
+        if value is None or not names:
+            continue
+        name = max(names, key=lambda n: turn.friction_demand[n])
+        k = int(np.argmax(rows[f"fd_{name}"]))
+        ax.plot(dist[k], value, "o", color="black", ms=4, zorder=5)
+        ax.annotate(f"{key} {value:.3f}", (dist[k], value), textcoords="offset points", xytext=(4, 4),
+                    fontsize=SMALL_PT)
+    ax.set_xlabel("distance travelled by unit 1 [m]")
+    ax.set_ylabel("friction demand √(Fx² + Fy²) / (μ Fz0) [-]")
+    top = max([float(np.max(f)) for k, f in rows.items() if k != "distance_m"] + [value for _l, value in levels])
+    ax.set_ylim(0.0, max(1.05, 1.1 * top))
+    ax.grid(True, lw=0.3)
+    return rows
+
+
+def draw_turn_paths(ax, turn) -> list:
+    """Both models' turn seen from above on ``ax``, to scale: the outside steer wheel's and the
+    last unit's inside rear wheel's paths and the swept region's envelope, kinematic (solid) and
+    with tire forces (dashed) [m]; the drawn paths as rows."""
+    v = turn.vehicle
+    steer = max((a for a in v.units[0].axles if a.steered), key=lambda a: a.x_m)
+    last = v.n_units - 1
+    rear = v.units[last].rearmost_axle
+    rows = []
+    for name, t, ls in (("kinematic", turn.kinematic, "-"), ("nonlinear", turn.turn, "--")):
+        if t is None:
+            continue
+        run = t.run
+        s = np.linspace(0.0, min(run.s_end, run.path.arc_end_s + 1.2 * t.overall_length_m), 600)
+        ow = run.unit_points(s, 0, [steer.x_m], [-steer.track_width_m / 2])[:, 0]
+        iw = run.unit_points(s, last, [rear.x_m], [rear.track_width_m / 2])[:, 0]
+        ax.plot(*ow.T, color=PALETTE[1], ls=ls, lw=1.1, label=f"{name}: outside wheel of axle {steer.name}")
+        ax.plot(*iw.T, color=PALETTE[2], ls=ls, lw=1.1, label=f"{name}: inside wheel of axle {rear.name}")
+        if t.lssp_m is not None:
+            C = run.path.centre
+            mid, r_min, r_max = t.envelope()
+            env = lambda rr: np.stack([C[0] + rr * np.sin(mid), C[1] - rr * np.cos(mid)], axis=1)  # noqa: E731
+            ax.plot(*env(r_max).T, color="black", ls=ls, lw=1.0, label=f"{name}: swept region (width {t.lssp_m:.2f} m)")
+            ax.plot(*env(r_min).T, color="black", ls=ls, lw=1.0)
+        rows += [{"model": name, "wheel": f"outside {steer.name}", "X_m": float(x), "Y_m": float(y)} for x, y in ow]
+        rows += [{"model": name, "wheel": f"inside {rear.name}", "X_m": float(x), "Y_m": float(y)} for x, y in iw]
+    ax.plot(*turn.kinematic.run.path.centre, "+", color="black", ms=8)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("X [m]")
+    ax.set_ylabel("Y [m]")
+    ax.grid(True, lw=0.3)
+    return rows
+
+
+def _title_of(turn) -> str:
+    return (f"{turn.vehicle.name}: the {turn.angle_deg:g}° turn at {turn.speed_kph:g} km/h, R = {turn.radius_m:g} m, "
+            f"μ = {turn.friction_coefficient:g} ({turn.tire} tires)")
+
+
+def fig_friction_demand(turn, limit: float | None = None, limits=(), title: str | None = None) -> Figure:
+    """The friction demand of every axle over the low-speed turn with tire forces
+    (docs/measures.md#friction-demand) against the distance unit 1 has travelled [m], each limit
+    drawn (``limit``: one value; ``limits``: (label, value) pairs).  ``turn`` is a
+    :class:`lcvreport.measures.friction_demand.TurnWithTireForces`."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, 3.6)
+    levels = list(limits) + ([("limit", limit)] if limit is not None else [])
+    rows = draw_friction_demand(ax, turn, levels)
+    ax.legend(fontsize=SMALL_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    fig.suptitle(title or f"friction demand: {_title_of(turn)}", fontsize=8)
+    keys = list(rows)
+    fig.lcv_data = [{k: float(rows[k][i]) for k in keys} for i in range(len(rows["distance_m"]))]
+    return fig
+
+
+def fig_turn_paths(turn, title: str | None = None) -> Figure:
+    """The low-speed turn of both models seen from above, to scale (:func:`draw_turn_paths`).
+    ``turn`` is a :class:`lcvreport.measures.friction_demand.TurnWithTireForces`."""
+    fig, ax = new_figure(PAGE_WIDTH_IN, 5.0)
+    rows = draw_turn_paths(ax, turn)
+    ax.legend(fontsize=SMALL_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    fig.suptitle(title or f"{_title_of(turn)}: kinematic (solid) and with tire forces (dashed; path error "
+                          f"≤ {turn.path_error_max_m:.3f} m)", fontsize=8)
+    fig.lcv_data = rows
+    return fig
+
+
+def fig_friction_demand_evidence(turn, limits, title: str) -> Figure:
+    """The evidence of a friction-demand measure: every axle's friction demand over the turn
+    with each level's limit drawn (``limits``: (label, value) pairs), above the swept path of
+    both models overlaid."""
+    fig = Figure(figsize=(PAGE_WIDTH_IN, 7.6), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1, height_ratios=[1.0, 1.3])
+    rows = draw_friction_demand(ax1, turn, limits)
+    ax1.legend(fontsize=SMALL_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    draw_turn_paths(ax2, turn)
+    ax2.legend(fontsize=SMALL_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    ax2.set_title(f"kinematic (solid) and with tire forces (dashed): path error ≤ {turn.path_error_max_m:.3f} m",
+                  fontsize=SMALL_PT + 1)
+    fig.suptitle(title, fontsize=8)
+    keys = list(rows)
+    fig.lcv_data = [{k: float(rows[k][i]) for k in keys} for i in range(len(rows["distance_m"]))]
+    return fig

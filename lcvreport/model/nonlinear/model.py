@@ -193,10 +193,11 @@ class NonlinearModel:
         v_b = (V * n).sum(axis=2)
         return psi, v1, r, e, n, V, u_b, v_b
 
-    def _axle_forces(self, kin, w, s, D):
-        """Per axle (b, n_axles): wheel-frame F_x, F_y [N], body-frame F_x, F_y, the moment about
-        the unit's CG of the axle's forces and moments [N m], the wheels' angle; at drive force
-        ``D`` (b,) [N], from the kinematics ``kin`` (:meth:`_kinematics`)."""
+    def _slips(self, kin, w, s):
+        """What of the axles' forces does not depend on the drive force: per axle (b, n_axles) the
+        slip angle's tangent, the wheels' angle d and its cosine and sine, the forward speed and
+        yaw rate of the axle's unit, the steer-independent moments (dual tires, residual T) and
+        the residual lateral force P, from the kinematics ``kin`` (:meth:`_kinematics`)."""
         psi, v1, r, e, n, V, u_b, v_b = kin
         delta, P, T, eps, a_c = self.split_input(w)
         au, xs = self._au, self._x
@@ -208,9 +209,21 @@ class NonlinearModel:
         uw = ua * cd + va * sd
         vw = -ua * sd + va * cd
         tan_a = vw / np.where(uw.real > 0, uw, -uw) if np.iscomplexobj(vw) else vw / np.abs(uw)
-        fx_tire = self._driven * (D[:, None] / self._drive_tires)         # per tire, driven axles share D
+        Mz0 = T - s * self._tires_CSD2 * ra / ua
         if self._linear_tires:
-            fy, mz = -s * self._CF * tan_a, s * self._CM * tan_a
+            lin = (-s * self._CF * tan_a, s * self._CM * tan_a)
+        else:
+            lin = None
+        return tan_a, d, cd, sd, Mz0, P, lin
+
+    def _axle_forces(self, slips, s, D):
+        """Per axle (b, n_axles): wheel-frame F_x, F_y [N], body-frame F_x, F_y, the moment about
+        the unit's CG of the axle's forces and moments [N m], the wheels' angle; at drive force
+        ``D`` (b,) [N], from the axles' slips (:meth:`_slips`)."""
+        tan_a, d, cd, sd, Mz0, P, lin = slips
+        fx_tire = self._driven * (D[:, None] / self._drive_tires)         # per tire, driven axles share D
+        if lin is not None:
+            fy, mz = lin
         else:
             ratio = fx_tire / self._mu_Fz
             if np.abs(ratio).max() >= 1.0:
@@ -219,10 +232,10 @@ class NonlinearModel:
             mu_y = self.mu * np.sqrt(1.0 - ratio * ratio)
             fy, mz = tire_laws.saturating(tan_a, s * self._CF, s * self._CM, self._Fz_tire, mu_y)
         Fx_w, Fy_w = self._tires * fx_tire, self._tires * fy
-        Mz = self._tires * mz - s * self._tires_CSD2 * ra / ua + T
+        Mz = self._tires * mz + Mz0
         Fx_b = Fx_w * cd - Fy_w * sd
         Fy_b = Fx_w * sd + Fy_w * cd + P
-        return Fx_w, Fy_w, Fx_b, Fy_b, xs * Fy_b + Mz, d
+        return Fx_w, Fy_w, Fx_b, Fy_b, self._x * Fy_b + Mz, d
 
     def _solve(self, x, w, U, s):
         """(z_rest', D, axle forces, kinematics) of a batch of states ``x`` (b, n) and inputs ``w``
@@ -252,13 +265,15 @@ class NonlinearModel:
         ext = (m[None, :] * a_c[:, None])[:, :, None] * self._Yhat - m[None, :, None] * bias
         inertial = np.einsum("bizc,bic->bz", W, ext)
         D = np.zeros(B, dtype=dtype)
+        slips = self._slips(kin, w, s)
+        Mr_inv = np.linalg.inv(Mr)                      # once for every pass of the drive force
         for _ in range(DRIVE_ITERATIONS):
-            Fx_w, Fy_w, Fx_b, Fy_b, moment, d = self._axle_forces(kin, w, s, D)
+            Fx_w, Fy_w, Fx_b, Fy_b, moment, d = self._axle_forces(slips, s, D)
             Fa = Fx_b[:, :, None] * e_au + Fy_b[:, :, None] * n_au                   # per axle, ground
             F = np.einsum("ij,bjc->bic", self._sum_by_unit, Fa)
             rhs = inertial + np.einsum("bizc,bic->bz", W, F)
             rhs[:, 2:] += moment @ self._sum_by_unit.T
-            zr = np.linalg.solve(Mr, rhs[:, 1:, None])[:, :, 0]
+            zr = np.einsum("bij,bj->bi", Mr_inv, rhs[:, 1:])
             # the u1 equation: the drive force's generalized force along u1 is D times its
             # direction's projection on e1 (1 for unsteered driven axles); solved for D
             g = (self._drive_share * np.cos(d)).sum(axis=1)
@@ -303,7 +318,7 @@ class NonlinearModel:
     def outputs(self, t, x: np.ndarray, w: np.ndarray, speed_mps: float, tire_scale: float = 1.0) -> dict:
         """Every signal of ``lcv simulate --model nonlinear`` [SI] (docs/nonlinear.md#outputs):
         ``X<i>``, ``Y<i>`` (CGs), ``psi<i>``, ``u1``, ``v<i>`` (each CG's lateral velocity in its
-        unit's axes), ``r<i>``, ``delta``, ``theta<k>``, ``ay<i>`` (each CG's lateral acceleration
+        unit's axes), ``r<i>``, ``delta``, ``theta<J>`` (joint J = A, B, ..., as the linear models'), ``ay<i>`` (each CG's lateral acceleration
         in its unit's axes), ``a_steer`` (the frontmost steered axle's), ``Fx_<axle>``, ``Fy_<axle>``
         (in the wheel's axes), ``fd_<axle>`` (friction demand), ``Y_<axle>`` (axle centres) and
         ``Y_rear`` (the last unit's rear end, as the linear models'); floats for one state, arrays
@@ -326,7 +341,7 @@ class NonlinearModel:
             out[f"v{i + 1}"], out[f"r{i + 1}"] = v_b[:, i], r[:, i]
         out["delta"] = self.split_input(w2)[0].copy()
         for k in range(N - 1):
-            out[f"theta{k + 1}"] = psi[:, k] - psi[:, k + 1]
+            out[f"theta{self.vehicle.joint_letters[k]}"] = psi[:, k] - psi[:, k + 1]
         ay = (A * n).sum(axis=2)
         for i in range(N):
             out[f"ay{i + 1}"] = ay[:, i]

@@ -1,0 +1,403 @@
+r"""The low-speed turn with tire forces (docs/nonlinear.md#the-low-speed-turn-with-tire-forces): the
+nonlinear model driven round the turn of docs/low_speed_turn.md by a path-following law, the
+turn's measures on its own poses, and the **friction demand** of every axle (docs/measures.md
+#friction-demand).
+
+The turn is section 16's: a straight approach, a circular arc to the left through ``angle_deg``
+on which the outside wheel of the frontmost steered axle runs at ``radius_m``, a straight exit of
+three overall lengths; unit 1's CG at ``speed_kph`` (5 km/h, walking pace).  The steer is
+
+  delta = delta_kin(s) + K e + (K^2 / 4) int e ds,
+
+delta_kin(s) the no-slip steer of the kinematic model at the same arc length s of the outside
+wheel's path (the angle between the path's tangent there and unit 1's heading in the kinematic
+run), e the outside wheel's signed distance from the path (positive to the left of its direction:
+steer right), the integral over unit 1's travel, K = ``path_gain_rad_per_m`` (2 rad/m).  The
+integral term holds the steer slip a tandem's scrub needs, which a proportional law would leave
+as a steady error (docs/nonlinear.md#the-low-speed-turn-with-tire-forces).  ``path_error_max_m``
+is max |e| over the run; beyond 0.05 m the law did not hold the path and the friction demands are
+null with that reason, never a number that means nothing; at 0.5 m the run stops (the turn is
+not being made).
+
+Friction demand of axle j at time t: ``FD_j = sqrt(F_x,j^2 + F_y,j^2) / (mu F_z0,j)`` -- the share of
+the friction available to the axle it uses (1: saturated); ``stfd`` the largest over the run of
+unit 1's steered axles', ``friction_demand_drive`` of its driven axles'.
+
+Examples
+--------
+>>> from lcvreport import load_vehicle
+>>> t = turn_with_tire_forces(load_vehicle("examples/vehicles/b_double.toml"), angle_deg=90.0)
+>>> 0.0 < t.stfd < 1.0, t.path_error_max_m < 0.05
+(True, True)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..analysis.integrate import integrate
+from ..model.body import overall_length_m
+from ..model.nonlinear.model import FRICTION_COEFFICIENT, driven_axles, nonlinear_model
+from ..model.vehicle import Vehicle
+from ..units import kph_to_mps
+from .low_speed import ANGLE_DEG, RADIUS_M, LowSpeedTurn, low_speed_turn, turn_of_run
+from ..util.cache import memoized
+from .registry import MeasureCase
+
+#: the turn's default speed [km/h]: walking pace
+TURN_SPEED_KPH = 5.0
+#: the path-following law's gain K [rad/m]
+PATH_GAIN_RAD_PER_M = 2.0
+#: the largest path error a turn's friction demand is given for [m]
+PATH_ERROR_MAX_M = 0.05
+#: the turn's integration tolerance: its friction demands agree with rtol 1e-8's to 1e-6
+#: (tests/test_friction_demand.py), at half the evaluations
+TURN_RTOL = 1e-5
+#: the path error at which the run stops: the turn is not being made [m]
+LOST_PATH_M = 0.5
+#: the spacing of the run's table of poses for the turn's measures [m]
+TABLE_M = 0.01
+#: the samples of the run per metre of path
+SAMPLES_PER_M = 10.0
+#: the keys of the family
+KEYS = ("stfd", "friction_demand_drive", "path_error_max_m")
+
+
+def path_coordinates(path, X, Y, s_hint=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(s, e) of points (X, Y) [m] in the kinematic frame (X forward, Y left) on the
+    straight-arc-straight ``path``: the arc length of each point's nearest point on the path [m]
+    and its signed distance from it, positive to the left of the path's direction [m].  Of the
+    approach, the arc and the exit, the nearest that the point projects onto; on an arc of more
+    than a lap the lap nearest ``s_hint`` [m] (where the point is expected).  Scalars or arrays
+    of one shape.
+
+    Examples
+    --------
+    >>> from lcvreport.manoeuvres.paths import StraightArcPath
+    >>> p = StraightArcPath(12.5, math.pi / 2, 20.0)
+    >>> s, e = path_coordinates(p, 12.0 * math.sin(0.5), 12.5 - 12.0 * math.cos(0.5))
+    >>> round(float(s), 6), round(float(e), 6)              # half a metre inside the arc at 0.5 rad
+    (6.25, 0.5)
+    """
+    X, Y = np.broadcast_arrays(np.asarray(X, dtype=float), np.asarray(Y, dtype=float))
+    hint = np.broadcast_to(np.asarray(s_hint, dtype=float), X.shape)
+    R, a = path.radius_m, path.angle_rad
+    Cx, Cy = float(path.centre[0]), float(path.centre[1])
+    inf = np.full(X.shape, np.inf)
+    # the approach (s <= 0)
+    d0 = np.where(X <= 0.0, np.abs(Y), inf)
+    # the arc: the angle from its start about the centre, on the lap nearest the hint
+    phi = np.arctan2(X - Cx, -(Y - Cy))
+    phi = phi + 2 * math.pi * np.round((np.clip(hint, 0.0, path.arc_end_s) / R - phi) / (2 * math.pi))
+    r = np.hypot(X - Cx, Y - Cy)
+    d1 = np.where((phi >= 0.0) & (phi <= a), np.abs(R - r), inf)
+    # the exit straight
+    ex, ey = R * math.sin(a), R * (1 - math.cos(a))
+    tx, ty = math.cos(a), math.sin(a)
+    along = (X - ex) * tx + (Y - ey) * ty
+    e2 = tx * (Y - ey) - ty * (X - ex)
+    d2 = np.where(along >= 0.0, np.abs(e2), inf)
+    # nearest to neither piece's interior: the corner points (the arc's ends)
+    dc0, dc1 = np.hypot(X, Y), np.hypot(X - ex, Y - ey)
+    d = np.stack([d0, d1, d2, dc0, dc1])
+    s = np.stack([X, R * phi, path.arc_end_s + along, np.zeros(X.shape), np.full(X.shape, path.arc_end_s)])
+    e = np.stack([Y, R - r, e2, dc0, dc1])
+    k = np.argmin(d, axis=0)[None]
+    return np.take_along_axis(s, k, 0)[0], np.take_along_axis(e, k, 0)[0]
+
+
+class PathFollowing:
+    r"""The nonlinear model steered round the turn by the path-following law (the module
+    docstring): the model's states and one more, the integral of the path error over unit 1's
+    travel ``E = int e ds`` [m^2]; a :class:`~lcvreport.model.base.VehicleModel` itself, so that one
+    integration carries both.  Called as the steer law (``law(t, X) -> delta``, columns of states).
+    """
+
+    vectorized = True
+
+    def __init__(self, model, kinematic_run, steer_axle, gain_rad_per_m: float, speed_mps: float):
+        self.model, self.run = model, kinematic_run
+        self.path = kinematic_run.path
+        self.kind, self.vehicle = model.kind, model.vehicle
+        self.x_m, self.half_track_m = float(steer_axle.x_m), float(steer_axle.track_width_m) / 2
+        self.K = float(gain_rad_per_m)
+        self.K_I = self.K ** 2 / 4                         # critically damped error in distance
+        self.U = float(speed_mps)
+        # delta_kin(s) on a 1 cm grid with the path's breaks (linear interpolation: < 1e-7 rad)
+        grid = np.union1d(np.linspace(0.0, kinematic_run.s_end, int(kinematic_run.s_end / 0.01) + 2),
+                          [b for b in self.path.breaks if 0.0 <= b <= kinematic_run.s_end])
+        tangent = np.minimum(grid, self.path.arc_end_s) / self.path.radius_m
+        self._s_grid = grid
+        self._delta_kin = tangent - kinematic_run.headings(grid)[:, 0]            # left positive
+        self._memo = (None, None, None)
+
+    @property
+    def state_names(self) -> tuple:
+        return (*self.model.state_names, "path_error_integral")
+
+    @property
+    def state_units(self) -> tuple:
+        return (*self.model.state_units, "m^2")
+
+    @property
+    def input_names(self) -> tuple:
+        return self.model.input_names
+
+    def wheel(self, X) -> tuple[np.ndarray, np.ndarray]:
+        """(X, Y) [m] in the kinematic frame of the outside (right) steer wheel, states as columns."""
+        psi = X[2]
+        c, sn = np.cos(psi), np.sin(psi)
+        return X[0] + self.x_m * c - self.half_track_m * sn, -(X[1] + self.x_m * sn + self.half_track_m * c)
+
+    def error(self, t, X) -> tuple[np.ndarray, np.ndarray]:
+        """(s, e) [m] of the outside steer wheel of the states ``X`` (columns) at times ``t``
+        (the last call's remembered: the law and the equations ask for the same states)."""
+        X = np.asarray(X, dtype=float)
+        key = (np.asarray(t, dtype=float).tobytes(), X.tobytes())
+        if self._memo[0] == key:
+            return self._memo[1], self._memo[2]
+        Xw, Yw = self.wheel(X)
+        s, e = path_coordinates(self.path, Xw, Yw, self.U * np.asarray(t, dtype=float))
+        self._memo = (key, s, e)
+        return s, e
+
+    def __call__(self, t, X) -> np.ndarray:
+        """The steer [rad, the model's sign: nose right positive] of the states ``X`` (n, k)."""
+        s, e = self.error(t, X)
+        delta_kin = np.interp(s, self._s_grid, self._delta_kin)        # clamped to the run's ends
+        return -delta_kin + self.K * e + self.K_I * np.asarray(X)[-1]
+
+    def lost(self, t, z) -> float:
+        """Positive while the outside steer wheel is within :data:`LOST_PATH_M` of its path
+        (the run's stop condition: beyond it the turn is not being made)."""
+        return LOST_PATH_M - abs(float(self.error(t, np.asarray(z)[:, None])[1][0]))
+
+    def derivatives(self, t, x, w, speed_mps, tire_scale=1.0):
+        x = np.asarray(x, dtype=float)
+        cols = np.atleast_2d(x)
+        dx = np.atleast_2d(self.model.derivatives(t, cols[:, :-1], w, speed_mps, tire_scale))
+        _s, e = self.error(t, cols.T)
+        out = np.column_stack([dx, self.U * e])
+        return out if x.ndim == 2 else out[0]
+
+    def outputs(self, t, x, w, speed_mps, tire_scale=1.0) -> dict:
+        x = np.asarray(x, dtype=float)
+        out = dict(self.model.outputs(t, x[..., :-1], w, speed_mps, tire_scale))
+        _s, e = self.error(t, np.atleast_2d(x).T)
+        out["path_error"] = e if x.ndim == 2 else float(e[0])
+        return out
+
+
+@dataclass(frozen=True)
+class SampledRun:
+    """The nonlinear run's poses in the kinematic model's interface (kinematic frame: X forward,
+    Y left, headings counter-clockwise), parameterized by the outside wheel's arc length s: what
+    :func:`lcvreport.measures.low_speed.turn_of_run` reads.  The states are tabulated every
+    :data:`TABLE_M` of travel from the integrator's dense output and interpolated linearly in s
+    (a pose within 1e-6 m on a 12.5 m arc: h^2 / 8R), so that the measures' many probes cost a
+    table look-up each."""
+
+    vehicle: Vehicle
+    path: object
+    s_grid: np.ndarray
+    states: np.ndarray
+    s_end: float
+    geometry: tuple = field(default=())
+
+    @classmethod
+    def of(cls, follow: "PathFollowing", response) -> "SampledRun":
+        """The table of ``response`` (a run of ``follow``), every :data:`TABLE_M` of unit 1's travel."""
+        t_end = float(response.time[-1])
+        t = np.linspace(0.0, t_end, max(int(math.ceil(follow.U * t_end / TABLE_M)), 2) + 1)
+        X = response.state_at(t)
+        s, _e = follow.error(t, X.T)
+        s = np.maximum.accumulate(s)
+        keep = np.concatenate([[True], np.diff(s) > 0])
+        return cls(follow.vehicle, follow.path, s[keep], X[keep], float(min(s[-1], follow.path.s_end)))
+
+    def _states(self, s) -> np.ndarray:
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        g = self.s_grid
+        k = np.clip(np.searchsorted(g, s) - 1, 0, g.size - 2)
+        w = np.clip((s - g[k]) / (g[k + 1] - g[k]), 0.0, 1.0)[:, None]
+        return (1.0 - w) * self.states[k] + w * self.states[k + 1]
+
+    def headings(self, s) -> np.ndarray:
+        N = self.vehicle.n_units
+        out = -self._states(s)[:, 2:2 + N]
+        return out[0] if np.ndim(s) == 0 else out
+
+    def unit_points(self, s, k: int, x_m, y_m) -> np.ndarray:
+        X = self._states(s)
+        v = self.vehicle
+        N = v.n_units
+        psi = X[:, 2:2 + N]
+        P = np.zeros((X.shape[0], 2))
+        P[:, 0], P[:, 1] = X[:, 0], X[:, 1]
+        for i in range(k):
+            a, b = v.units[i].rear_coupling_m, v.units[i + 1].front_coupling_m
+            P[:, 0] += a * np.cos(psi[:, i]) - b * np.cos(psi[:, i + 1])
+            P[:, 1] += a * np.sin(psi[:, i]) - b * np.sin(psi[:, i + 1])
+        x = np.atleast_1d(np.asarray(x_m, dtype=float))
+        y = -np.atleast_1d(np.asarray(y_m, dtype=float))          # the kinematic frame's y is to the left
+        c, sn = np.cos(psi[:, k])[:, None], np.sin(psi[:, k])[:, None]
+        Xw = P[:, None, 0] + c * x - sn * y
+        Yw = P[:, None, 1] + sn * x + c * y
+        return np.stack([Xw, -Yw], axis=-1)                      # back to the kinematic frame (Y left)
+
+
+@dataclass(frozen=True)
+class TurnWithTireForces:
+    """The low-speed turn of the nonlinear model (see the module docstring): the run
+    (``response``), the friction demand of every axle over it, ``stfd``, ``friction_demand_drive``,
+    ``path_error_max_m``, the turn's measures on this run's poses (``turn``) beside the kinematic
+    model's (``kinematic``), and why a measure is null (``undefined``)."""
+
+    vehicle: Vehicle
+    radius_m: float
+    angle_deg: float
+    speed_kph: float
+    friction_coefficient: float
+    path_gain_rad_per_m: float
+    tire: str
+    response: object
+    friction_demand: dict
+    stfd: float | None
+    friction_demand_drive: float | None
+    path_error_max_m: float
+    turn: LowSpeedTurn | None
+    kinematic: LowSpeedTurn
+    undefined: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """The JSON of ``lcv turn --model nonlinear``."""
+        turn = self.turn.to_dict() if self.turn is not None else None
+        return {"model": "nonlinear", "tire": self.tire, "radius_m": self.radius_m, "angle_deg": self.angle_deg,
+                "speed_kph": self.speed_kph, "friction_coefficient": self.friction_coefficient,
+                "path_gain_rad_per_m": self.path_gain_rad_per_m, "stfd": self.stfd,
+                "friction_demand_drive": self.friction_demand_drive, "path_error_max_m": self.path_error_max_m,
+                "friction_demand": dict(self.friction_demand), "turn": turn, "kinematic": self.kinematic.to_dict(),
+                "reasons": dict(self.undefined)}
+
+    def plot(self, limit: float | None = None):
+        """Every axle's friction demand over the run, the limit drawn (:func:`lcvreport.plotting.low_speed.fig_friction_demand`)."""
+        from ..plotting.low_speed import fig_friction_demand
+        return fig_friction_demand(self, limit)
+
+
+@memoized(16)
+def turn_with_tire_forces(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
+                          speed_kph: float = TURN_SPEED_KPH,
+                          friction_coefficient: float = FRICTION_COEFFICIENT,
+                          path_gain_rad_per_m: float = PATH_GAIN_RAD_PER_M, tire: str = "saturating",
+                          tire_scale: float = 1.0, rtol: float = TURN_RTOL) -> TurnWithTireForces:
+    """The low-speed turn of ``vehicle`` on the nonlinear model, steered by the path-following law
+    (see the module docstring).
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        With the turn's body keys (docs/low_speed_turn.md) and every axle's ``static_load_N``.
+    radius_m, angle_deg : float
+        The outside steer wheel's radius [m] and the turn's angle [deg].
+    speed_kph : float
+        Unit 1's forward speed [km/h] (default 5).
+    friction_coefficient : float
+        mu, in (0, 2].
+    path_gain_rad_per_m : float
+        K of the path-following law [rad/m].
+    tire : {"saturating", "linear"}
+    tire_scale : float
+    rtol : float
+        The integration's relative tolerance.
+
+    Returns
+    -------
+    TurnWithTireForces
+
+    Raises
+    ------
+    TurnError
+        Missing geometry, a radius or angle out of range.
+    IntegrationError
+        A driven axle out of friction (the speed cannot be held), naming the axle and the time.
+    """
+    from ..ranges import RANGES
+    RANGES["speed"].check(kph_to_mps(speed_kph), "turn speed", factor=3.6, unit="km/h")
+    RANGES["path_gain"].check(path_gain_rad_per_m, "path_gain_rad_per_m")
+    kinematic = low_speed_turn(vehicle, radius_m, angle_deg)
+    model = nonlinear_model(vehicle, tire, friction_coefficient)
+    kin = kinematic.run
+    path = kin.path
+    u1 = vehicle.units[0]
+    steer_axle = max((a for a in u1.axles if a.steered), key=lambda a: a.x_m)
+    half = steer_axle.track_width_m / 2
+    U = kph_to_mps(speed_kph)
+
+    follow = PathFollowing(model, kin, steer_axle, path_gain_rad_per_m, U)
+    x0 = np.zeros(len(follow.state_names))
+    x0[0], x0[1] = -steer_axle.x_m, -half                      # the outside wheel at the path's start
+    t_end = float(path.s_end / U)
+    dt = 1.0 / (SAMPLES_PER_M * U)
+    n = max(int(math.ceil(t_end / dt)), 200)
+    t_end = n * dt
+    r = integrate(follow, follow, U, t_end, dt, tire_scale, x0=x0, rtol=rtol, label="low-speed turn",
+                  stop=follow.lost)
+    s_run, e_run = follow.error(r.time, r.state_at(r.time).T)
+    s_mono = np.maximum.accumulate(s_run)
+    path_error = float(np.abs(e_run).max())
+    fd = {a.name: float(np.max(r[f"fd_{a.name}"])) for a in vehicle.axles}
+    steered = [a.name for a in u1.axles if a.steered]
+    driven = [a.name for a, d in zip(vehicle.axles, driven_axles(vehicle)) if d]
+    undefined = {}
+    stfd = max(fd[a] for a in steered)
+    drive = max(fd[a] for a in driven)
+    conditions = (f"K = {path_gain_rad_per_m:g} rad/m, {speed_kph:g} km/h, mu = {friction_coefficient:g}, "
+                  f"{tire} tires")
+    if r.stopped_at is not None:
+        path_error = max(path_error, LOST_PATH_M)
+        why = (f"undefined: the combination left the path: its outside steer wheel was {LOST_PATH_M:g} m off it at "
+               f"t = {r.stopped_at:.2f} s, {float(s_mono[-1]):.1f} m along it ({conditions}); the turn is not "
+               "made, so it has no friction demand")
+    elif path_error > PATH_ERROR_MAX_M:
+        why = (f"undefined: the path-following law held the outside steer wheel within {path_error:.3g} m of its "
+               f"path, not {PATH_ERROR_MAX_M:g} m ({conditions}): the friction demand of a turn not made is not "
+               "the turn's")
+    else:
+        why = None
+    if why is not None:
+        stfd = drive = None
+        undefined.update({"stfd": why, "friction_demand_drive": why})
+    run = SampledRun.of(follow, r)
+    if r.stopped_at is not None:
+        turn = None
+        undefined["turn"] = why
+    else:
+        turn = turn_of_run(vehicle, run, radius_m, angle_deg)
+    return TurnWithTireForces(vehicle, float(radius_m), float(angle_deg), float(speed_kph),
+                              float(friction_coefficient), float(path_gain_rad_per_m), tire, r, fd, stfd, drive,
+                              path_error, turn, kinematic, undefined)
+
+
+def friction_demand_family(case: MeasureCase) -> tuple[dict, dict]:
+    """The registry's ``friction_demand`` family of one case: the turn with tire forces at the
+    case's conditions (the turn's radius and angle, ``turn_speed_kph``, ``friction_coefficient``,
+    ``path_gain_rad_per_m``)."""
+    from ..analysis.integrate import IntegrationError
+    from ..model.body import TurnError
+    from ..model.vehicle import VehicleError
+    try:
+        t = turn_with_tire_forces(case.vehicle, case.condition("turn_radius_m"), case.condition("turn_angle_deg"),
+                                  case.condition("turn_speed_kph"), case.condition("friction_coefficient"),
+                                  case.condition("path_gain_rad_per_m"), tire_scale=case.tire_scale)
+    except (TurnError, VehicleError, IntegrationError, ValueError) as exc:
+        why = f"undefined: {exc}"
+        return dict.fromkeys(KEYS), dict.fromkeys(KEYS, why)
+    values = {"stfd": t.stfd, "friction_demand_drive": t.friction_demand_drive, "path_error_max_m": t.path_error_max_m}
+    return values, {k: why for k, why in t.undefined.items() if k in KEYS}
+
+
+__all__ = ["TurnWithTireForces", "turn_with_tire_forces", "friction_demand_family", "path_coordinates",
+           "overall_length_m"]
