@@ -78,6 +78,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``friction_demand``  the turn with tire forces (nonlinear model, path-following law): STFD, drive-tyre demand
     ``rollover``         the static rollover threshold: quasi-static, lift-off axle by axle, exact events
     ``roll``             the roll measures: LTR, roll gains, the yaw-roll model's RA, HSTO, damping
+    ``ra_points``        rearward amplification's numerator and denominator points (sprung CG, roll axis, steer axle)
     ``measure_set``      every measure of a vehicle at a speed (MeasureSet)
     ``criteria``         the user's limits and the verdicts
     ``scheme``           scheme files: levels, and per measure its conditions and limits per level

@@ -217,7 +217,8 @@ def check_lane_change_steer(r: TimeResponse, peak_rad: float | None = None) -> N
     ManoeuvreError
     """
     from ..ranges import RANGES
-    if not r.steer.prescribes_acceleration and r.steer.driver is None:
+    steer = getattr(r, "steer", None)
+    if not getattr(steer, "prescribes_acceleration", False) and getattr(steer, "driver", None) is None:
         return
     peak = float(r.peaks_abs(["delta"])[0]) if peak_rad is None else float(peak_rad)
     rng = RANGES["steer_angle"]

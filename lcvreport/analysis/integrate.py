@@ -29,6 +29,7 @@ import numpy as np
 
 from ..model.base import check_speed, check_tire_scale
 from ..ranges import RANGES
+from ..util.threads import one_blas_thread
 from .time_response import SampledResponse
 
 #: the integration's default relative tolerance (docs/nonlinear.md#integration)
@@ -70,6 +71,7 @@ def input_vector(model, delta: float, sources=None, tire_scale: float = 1.0) -> 
     return w
 
 
+@one_blas_thread
 def integrate(model, steer, speed_mps: float, t_end: float, dt: float, tire_scale: float = 1.0, sources=None,
               x0: np.ndarray | None = None, rtol: float = RTOL, atol: float | None = None,
               label: str = "", stop=None, max_evaluations: int = MAX_EVALUATIONS) -> SampledResponse:
@@ -208,6 +210,7 @@ def integrate(model, steer, speed_mps: float, t_end: float, dt: float, tire_scal
     r = SampledResponse(model, time, pieces, u, tire_scale, delta_of, w0, label or getattr(steer, "spec", ""))
     r.stopped_at = stopped_at
     r.evaluations = count[0]
+    r.steer = steer
     return r
 
 

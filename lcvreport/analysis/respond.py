@@ -14,7 +14,7 @@ True
 """
 from __future__ import annotations
 
-from ..model.base import LINEAR_MODELS, build_model, check_model
+from ..model.base import build_model, check_model
 
 
 def respond(vehicle, model: str, steer, speed_mps: float, t_end: float, dt: float, tire_scale: float = 1.0,
@@ -35,16 +35,20 @@ def respond(vehicle, model: str, steer, speed_mps: float, t_end: float, dt: floa
     sources : ResidualSources, optional
         The residual sources, for any other model.
     options : dict, optional
-        The model's options (the nonlinear model's ``tire`` and ``friction_coefficient``).
+        The model's options (the nonlinear model's ``tire`` and ``friction_coefficient``) and
+        the integration's ``rtol`` (default :data:`lcvreport.analysis.integrate.RTOL`).
 
     Returns
     -------
     TimeResponse or SampledResponse
     """
-    name = check_model(model)
-    if name in LINEAR_MODELS:
+    from ..model import linear
+    if str(model).replace("-", "_") in linear.MODELS:         # a linear model (a registered one too)
         from .exact import response
-        return response(vehicle, speed_mps, steer, t_end, dt, F=F, tire_scale=tire_scale, model=name)
-    from .integrate import integrate
-    return integrate(build_model(vehicle, name, **(options or {})), steer, speed_mps, t_end, dt, tire_scale,
-                     sources=sources)
+        return response(vehicle, speed_mps, steer, t_end, dt, F=F, tire_scale=tire_scale, model=model)
+    name = check_model(model)
+    from .integrate import RTOL, integrate
+    options = dict(options or {})
+    rtol = options.pop("rtol", RTOL)
+    return integrate(build_model(vehicle, name, **options), steer, speed_mps, t_end, dt, tire_scale,
+                     sources=sources, rtol=rtol)

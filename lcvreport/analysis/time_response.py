@@ -412,6 +412,8 @@ class SampledResponse:
         self.stopped_at = None
         #: how many evaluations of the model's equations the run took
         self.evaluations = 0
+        #: the steer input or law the run was driven by
+        self.steer = None
 
     # ------------------------------------------------------------------ the dense output
     def state_at(self, t) -> np.ndarray:

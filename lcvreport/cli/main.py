@@ -171,6 +171,11 @@ def build_parser() -> argparse.ArgumentParser:
     residuals(mea)
     conditions(mea)
     mea.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
+    from ..model.base import CLI_NAMES
+    mea.add_argument("--model", default="yaw-plane", choices=tuple(CLI_NAMES.values()),
+                     help="the model of the manoeuvres' and eigenvalues' measures (their keys are the same on every "
+                          "model: hsto_m of the yaw-roll model is the default's hsto_m_roll); nonlinear: its "
+                          "responses, its linearization's eigenvalues and its friction demand (docs/model.md)")
     mea.add_argument("--json", action="store_true", help="machine-readable output")
     fmu = sub.add_parser("fmu", help="FMUs of the vehicle (FMI 2.0 or 3.0; native: Co-Simulation and Model Exchange)")
     source(fmu, masses=False)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from ..measures.registry import MEASURES
 from ..units import mps_to_kph
-from .options import UsageError, _load_units, _parse_speeds, _sources, _vehicle
+from .options import UsageError, _line, _load_units, _parse_speeds, _sources, _vehicle
 from .output import _finite, _Out
 
 
@@ -29,11 +29,19 @@ def _cmd_measures(args, out: _Out) -> int:
                                                                        "crossfall_percent")
                   and getattr(args, k, None) is not None}
     f_hz = args.ra_frequency_hz if args.ra_frequency_hz is not None else CONDITIONS["ra_frequency_hz"].default
+    model = getattr(args, "model", "yaw-plane").replace("-", "_")
+    if model != "yaw_plane":                    # the model's keys checked before any measure is computed
+        from ..model.base import build_model
+        from ..model.vehicle import VehicleError
+        try:
+            build_model(v, model)
+        except (VehicleError, ValueError) as exc:
+            raise UsageError(f"argument --model {args.model}: {_line(exc)}") from None
     docs, sets = [], []
     for u in speeds:
         try:
             m = measure_set(v, u, args.tire_scale, units, f_hz=f_hz, sources=sources if sources else None,
-                            conditions=conditions)
+                            conditions=conditions, model=model)
         except ValueError as exc:
             if "static_load_N" in str(exc):
                 raise UsageError(f"argument --load: {exc}") from None
@@ -59,8 +67,9 @@ def _cmd_measures(args, out: _Out) -> int:
                                                              else str(flat[c])) for c in cols))
         return 0
     m, doc = sets[0], docs[0]
+    on = "" if model == "yaw_plane" else f", the {args.model} model's manoeuvres and eigenvalues"
     out.line(f"{v.name} at {args.speed_kph or args.speed_mph} {unit} ({mps_to_kph(m.speed_mps):.1f} km/h), tire scale "
-             f"{args.tire_scale:g}")
+             f"{args.tire_scale:g}{on}")
     for line in text_lines(m.rows()):
         out.line(line)
     if criteria is not None:

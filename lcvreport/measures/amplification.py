@@ -27,7 +27,6 @@ from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ, _freq, steer_to_acceleration
 from ..model.linear import check_speed, check_tire_scale, linear_model, stiffness
 from ..model.vehicle import Vehicle
-from ..model.yaw_plane.equations import system_coefficients
 from .registry import MeasureCase
 
 #: single sine: step [s], time after the sine [s], default amplitude [rad]
@@ -92,12 +91,13 @@ class SingleSine:
 def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_HZ,
                 delta0_rad: float = SINGLE_SINE_DELTA0_RAD, tire_scale: float = 1.0,
                 step_s: float = SINGLE_SINE_STEP_S, tail_s: float = SINGLE_SINE_TAIL_S,
-                model: str = "yaw_plane") -> SingleSine:
+                model: str = "yaw_plane", options: dict | None = None) -> SingleSine:
     """The single-sine manoeuvre from rest (docs/measures.md, docs/manoeuvres.md): the continuous steer
     ``delta = delta0 sin(2 pi f t)`` for ``0 <= t <= 1/f``, then straight ahead for
     ``tail_s``; the exact response (:func:`lcvreport.analysis.exact.response`), sampled
-    every ``step_s``, its peaks located on the continuous response; on the linear model
-    ``model`` (default the yaw plane).
+    every ``step_s``, its peaks located on the continuous response; on the model ``model``
+    (default the yaw plane; a model that is not linear integrated:
+    :func:`lcvreport.analysis.respond.respond`, with its ``options``).
 
     Examples
     --------
@@ -106,12 +106,12 @@ def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_H
     >>> s.ay.shape, round(s.rearward_amplification, 2)
     ((5251, 6), 4.79)
     """
-    from ..analysis.exact import response
+    from ..analysis.respond import respond
     from ..manoeuvres.steer import sine
     f = float(_freq(f_hz))
     steer = sine(delta0_rad, f)
     t_end = round((1.0 / f + tail_s) / step_s) * step_s
-    r = response(vehicle, speed_mps, steer, t_end, step_s, tire_scale=tire_scale, model=model)
+    r = respond(vehicle, model, steer, speed_mps, t_end, step_s, tire_scale, options=options)
     peaks = r.peaks_abs([f"ay{i + 1}" for i in range(vehicle.n_units)])
     return SingleSine(r.time, f, float(delta0_rad), float(speed_mps), vehicle, peaks, r)
 
@@ -128,11 +128,11 @@ class RAPeak:
     frequency_hz: float
 
 
-def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RAPeak:
+def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, model: str = "yaw_plane") -> RAPeak:
     """max over 0.1-2 Hz of RA(f) = |G_N(j 2 pi f)| / |G_1(j 2 pi f)| and where it is
     (a 0.005 Hz scan, then the zero of d ln RA / df in the best bracket: the derivative
     exact from the same factorisation, ``dz/dw = -(jwM - S)^-1 jM z``, Brent's root finder
-    to 1e-13 Hz; a maximum is flat, its zero-slope point is not).
+    to 1e-13 Hz; a maximum is flat, its zero-slope point is not); on the linear model ``model``.
 
     Examples
     --------
@@ -147,7 +147,7 @@ def ra_peak(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RAPe
     f = np.linspace(lo, hi, 381)
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
-    co = system_coefficients(vehicle)           # once: the search asks for ~10 single frequencies
+    co = linear_model(vehicle, model)           # once: the search asks for ~10 single frequencies
     u = float(speed_mps)
     M, S, b = co.M(u), co.S(u, tire_scale), co.B_delta(tire_scale)
     ends = np.array([0, vehicle.n_units - 1])
@@ -368,7 +368,7 @@ def single_sine_batched(batch: VariantBatch, speed_mps: float, f_hz: float | Non
 def frequency_response_family(case: MeasureCase) -> tuple[dict, dict]:
     """The registry's ``frequency_response`` family of one case: RA at ``case.f_hz`` and every
     unit's gain |G_i| [m/s^2 per rad]."""
-    gains = np.abs(steer_to_acceleration(case.vehicle, case.speed_mps, case.f_hz, case.tire_scale))
+    gains = np.abs(steer_to_acceleration(case.vehicle, case.speed_mps, case.f_hz, case.tire_scale, case.model))
     return {"ra_frequency": float(gains[-1] / gains[0]), "ay_gain_per_unit": [float(g) for g in gains]}, {}
 
 
@@ -379,12 +379,19 @@ def ra_frequency_batched(batch: VariantBatch, speed_mps: float, f_hz: float, tir
 
 def single_sine_family(case: MeasureCase) -> tuple[dict, dict]:
     """The registry's ``single_sine`` family of one case."""
-    ss = single_sine(case.vehicle, case.speed_mps, case.f_hz, tire_scale=case.tire_scale)
+    ss = single_sine(case.vehicle, case.speed_mps, case.f_hz, tire_scale=case.tire_scale, model=case.model,
+                     options=case.model_options())
     r = ss.response.peaks_abs([f"r{i + 1}" for i in (0, case.vehicle.n_units - 1)])
-    return {"ra_single_sine": ss.rearward_amplification, "ra_yaw_rate_single_sine": float(r[1] / r[0])}, {}
+    ra = ss.rearward_amplification
+    if case.model == "yaw_roll":                 # the yaw-roll RA between its reference points
+        from .ra_points import ra_points, rearward_amplification
+        points = ra_points(case.conditions.get("ra_numerator"), case.conditions.get("ra_denominator"),
+                           "ra_single_sine_roll")
+        ra = rearward_amplification(ss.response, case.vehicle.n_units, *points)
+    return {"ra_single_sine": ra, "ra_yaw_rate_single_sine": float(r[1] / r[0])}, {}
 
 
 def ra_peak_family(case: MeasureCase) -> tuple[dict, dict]:
     """The registry's ``ra_peak`` family of one case."""
-    p = ra_peak(case.vehicle, case.speed_mps, case.tire_scale)
+    p = ra_peak(case.vehicle, case.speed_mps, case.tire_scale, case.model)
     return {"ra_peak": p.value, "ra_peak_frequency_hz": p.frequency_hz}, {}

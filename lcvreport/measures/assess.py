@@ -79,6 +79,10 @@ class MeasureVerdict:
     resolved: dict = dataclasses.field(default_factory=dict)
     #: per level, the resolved limit as a reader reads it (``<= 5.7 × 0.4799 = 2.736``)
     limit_texts: dict = dataclasses.field(default_factory=dict)
+    #: the model it was taken on (the scheme entry's ``model``)
+    model: str = "yaw_plane"
+    #: the value on each model the scheme asked for beside it (``beside``), not judged: {model: value or None}
+    beside: dict = dataclasses.field(default_factory=dict)
 
     @property
     def unit(self) -> str:
@@ -97,7 +101,9 @@ class MeasureVerdict:
         """The value as a verdict table shows it: the number, ``>= 0.6901 (every joint heavily
         damped)`` for a null known by its lower bound, or ``none``."""
         if self.value is not None:
-            return f"{self.value:.{digits}g}"
+            others = "".join(f" ({m.replace('_', '-')}: {'none' if b is None else f'{b:.{digits}g}'})"
+                             for m, b in self.beside.items())
+            return f"{self.value:.{digits}g}{others}"
         if self.lower_bound is not None:
             why = " (every joint heavily damped)" if self.key == "yaw_damping_coefficient" else ""
             return f">= {self.lower_bound:.{digits}g}{why}"
@@ -129,6 +135,8 @@ class MeasureVerdict:
                 continue
             unit = "°" if c.unit == "deg" else f" {c.unit}"
             parts.append(f"{c.short} {v:g}{unit}".strip())
+        if self.model != "yaw_plane":
+            parts.append(f"{self.model.replace('_', '-')} model")
         if parts:
             return ", ".join(parts)
         return "quasi-static" if MEASURES[self.key].family == "rollover" else "-"
@@ -141,7 +149,9 @@ class MeasureVerdict:
                 "verdicts": dict(self.verdicts), "level_reached": self.level_reached, "reason": self.reason,
                 "unit": self.unit, "limits": dict(self.limits),
                 "limits_resolved": {level: dict(b) for level, b in self.resolved.items()},
-                "margins": dict(self.margins)}
+                "margins": dict(self.margins),
+                **({"model": self.model} if self.model != "yaw_plane" else {}),
+                **({"beside": dict(self.beside)} if self.beside else {})}
 
 
 @dataclass(frozen=True)
@@ -242,12 +252,12 @@ def _groups(scheme: Scheme) -> list[dict]:
     groups = []
     for m in scheme.measures:
         for g in groups:
-            if all(g["conditions"].get(k, v) == v for k, v in m.conditions.items()):
+            if g["model"] == m.model and all(g["conditions"].get(k, v) == v for k, v in m.conditions.items()):
                 g["conditions"].update(m.conditions)
                 g["members"].append(m)
                 break
         else:
-            groups.append({"conditions": dict(m.conditions), "members": [m]})
+            groups.append({"conditions": dict(m.conditions), "members": [m], "model": m.model})
     return groups
 
 
@@ -297,7 +307,7 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
             keys += [k for k in ("trim.delta_rad", "trim.offtracking_m") if k not in keys]
         reasons = {}
         values = measure_values(vehicle, speed, keys, tire_scale, load_units, f_hz, src if src else None,
-                                others, reasons=reasons)
+                                others, reasons=reasons, model=g["model"])
         doc = dict(values)
         if any(k.startswith("trim.") for k in keys):
             doc["trim"] = None if values.get("trim.delta_rad") is None else {
@@ -308,6 +318,10 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
         doc["reasons"] = reasons
         for m in g["members"]:
             verdicts[m.key] = _verdict(m, doc, scheme.levels)
+            if m.beside:                      # the value on other models, shown beside, not judged
+                beside = {b: measure_values(vehicle, speed, [m.key], tire_scale, load_units, f_hz,
+                                            src if src else None, others, model=b)[m.key] for b in m.beside}
+                verdicts[m.key] = dataclasses.replace(verdicts[m.key], beside=beside)
     measures = tuple(verdicts[m.key] for m in scheme.measures)
     reached = next((level for level in scheme.levels if all(m.verdicts[level] == "pass" for m in measures)), None)
     reason = None
@@ -352,7 +366,7 @@ def _verdict(m, doc: dict, levels) -> MeasureVerdict:
         texts[level] = _limit_text(spec, nums, doc)
         margins[level] = _margin(value, nums, spec.absolute) if verdicts[level] != "not computed" else None
     return MeasureVerdict(m.key, dict(m.conditions), value, verdicts, limits, notes, reached, reason, bounds,
-                          lower, margins, resolved, texts)
+                          lower, margins, resolved, texts, getattr(m, "model", "yaw_plane"))
 
 
 def _margin(value, bounds: tuple, absolute: bool) -> float | None:

@@ -72,26 +72,29 @@ def evidence(assessment, verdict) -> Evidence:
             c.get("lane_change_frequency_hz", CONDITIONS["lane_change_frequency_hz"].default))
     f_hz = c.get("ra_frequency_hz", CONDITIONS["ra_frequency_hz"].default)
     n = v.n_units
+    axis = getattr(verdict, "model", "yaw_plane")           # the scheme entry's model (the model axis)
     if family == "lane_change" or key in ROLL_LANE_CHANGE:
         from .offtracking import lane_change_measures
-        model = "yaw_roll" if key in ROLL_LANE_CHANGE else "yaw_plane"
+        model = "yaw_roll" if key in ROLL_LANE_CHANGE else axis
         return Evidence("lane_change", lane_change_measures(v, speed, s, *lane, model=model), verdict, levels, model,
                         _ratio(key, c, n, (f"ay{n}", "a_steer")))
     if family == "driver_lane_change":
         from .offtracking import driver_lane_change_measures
         K = c.get("driver_gain_rad_per_m", CONDITIONS["driver_gain_rad_per_m"].default)
         T = c.get("driver_preview_s", CONDITIONS["driver_preview_s"].default)
-        return Evidence("lane_change", driver_lane_change_measures(v, speed, s, *lane, K, T), verdict, levels,
-                        ratio=_ratio(key, c, n, (f"ay{n}", "a_steer")))
+        return Evidence("lane_change", driver_lane_change_measures(v, speed, s, *lane, K, T, model=axis,
+                                                                   options=_options(axis, c)),
+                        verdict, levels, axis, _ratio(key, c, n, (f"ay{n}", "a_steer"), axis))
     if family == "single_sine" or key in ROLL_SINGLE_SINE:
         from .amplification import single_sine
-        model = "yaw_roll" if key in ROLL_SINGLE_SINE else "yaw_plane"
+        model = "yaw_roll" if key in ROLL_SINGLE_SINE else axis
         plain = (f"r{n}", "r1") if key == "ra_yaw_rate_single_sine" else (f"ay{n}", "ay1")
-        return Evidence("single_sine", single_sine(v, speed, f_hz, tire_scale=s, model=model), verdict, levels, model,
+        return Evidence("single_sine", single_sine(v, speed, f_hz, tire_scale=s, model=model,
+                                                   options=_options(model, c)), verdict, levels, model,
                         _ratio(key, c, n, plain))
     if family == "yaw_damping":
         from .yaw_damping import yaw_damping_coefficient
-        return Evidence("pulse", yaw_damping_coefficient(v, speed, s), verdict, levels)
+        return Evidence("pulse", yaw_damping_coefficient(v, speed, s, axis, _options(axis, c)), verdict, levels, axis)
     if family == "low_speed_turn":
         from .low_speed import low_speed_turn
         return Evidence("swept_path", low_speed_turn(v, c["turn_radius_m"], c["turn_angle_deg"]), verdict, levels)
@@ -115,14 +118,27 @@ def evidence(assessment, verdict) -> Evidence:
     return Evidence("value", None, verdict, levels)
 
 
-def _ratio(key: str, conditions: dict, n_units: int, plain: tuple) -> tuple:
+def _options(model: str, conditions: dict) -> dict | None:
+    """The model options of a measure's manoeuvre on ``model`` (the nonlinear model's tire law,
+    friction coefficient and integration tolerance, as the measure was computed with)."""
+    if model != "nonlinear":
+        return None
+    from .registry import MEASURE_RTOL
+    return {"tire": "saturating", "rtol": MEASURE_RTOL,
+            "friction_coefficient": conditions.get("friction_coefficient", CONDITIONS["friction_coefficient"].default)}
+
+
+def _ratio(key: str, conditions: dict, n_units: int, plain: tuple, model: str = "yaw_plane") -> tuple:
     """The (numerator, denominator) signals of a ratio measure: a yaw-roll RA's from its
-    reference points (:data:`lcvreport.measures.roll.RA_POINTS`), the others' ``plain``; () for a
-    measure that is no ratio."""
+    reference points (:data:`lcvreport.measures.roll.RA_POINTS`; a lane change's RA on the
+    yaw-roll model axis as ``ra_lane_change_roll``'s), the others' ``plain``; () for a measure
+    that is no ratio."""
     if not key.startswith("ra_"):
         return ()
-    if key in ("ra_single_sine_roll", "ra_lane_change_roll"):
-        from .roll import RA_POINTS, ra_points
-        num, den = ra_points(conditions.get("ra_numerator"), conditions.get("ra_denominator"), key)
+    roll = key if key in ("ra_single_sine_roll", "ra_lane_change_roll") else (
+        "ra_lane_change_roll" if model == "yaw_roll" and key == "ra_lane_change_driver" else None)
+    if roll is not None:
+        from .ra_points import RA_POINTS, ra_points
+        num, den = ra_points(conditions.get("ra_numerator"), conditions.get("ra_denominator"), roll)
         return RA_POINTS[num].format(n=n_units), RA_POINTS[den].format(n=n_units)
     return plain

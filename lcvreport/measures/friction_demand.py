@@ -44,6 +44,7 @@ from ..model.vehicle import Vehicle
 from ..units import kph_to_mps
 from .low_speed import ANGLE_DEG, RADIUS_M, LowSpeedTurn, low_speed_turn, turn_of_run
 from ..util.cache import memoized
+from ..util.threads import one_blas_thread
 from .registry import MeasureCase
 
 #: the turn's default speed [km/h]: walking pace
@@ -288,6 +289,7 @@ class TurnWithTireForces:
 
 
 @memoized(16)
+@one_blas_thread
 def turn_with_tire_forces(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
                           speed_kph: float = TURN_SPEED_KPH,
                           friction_coefficient: float = FRICTION_COEFFICIENT,

@@ -56,6 +56,7 @@ from ..model.body import TurnError, _need_bodies, _need_tracks, corners, overall
 from ..model.low_speed.kinematics import KinematicRun, KinematicsError, integrate
 from ..model.vehicle import Vehicle
 from ..util.cache import memoized
+from ..util.threads import one_blas_thread
 from .registry import MeasureCase
 
 
@@ -321,6 +322,7 @@ def _extreme(probe: _Probe, value, sign: float, s: np.ndarray, centre: np.ndarra
 
 
 @memoized(32)
+@one_blas_thread
 def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
                    rtol: float = 1e-10, atol: float = 1e-12) -> LowSpeedTurn:
     """The low-speed turn of ``vehicle`` and its measures (docs/low_speed_turn.md); computed

@@ -53,6 +53,8 @@ class MeasureSet:
     trim: Trim | None = None
     #: the conditions given other than the speed and f_hz (the rest at their defaults)
     conditions: dict = field(default_factory=dict)
+    #: the model of the model-axis families (docs/model.md#the-model-object): the yaw plane by default
+    model: str = "yaw_plane"
 
     def __getattr__(self, name: str):
         if not name.startswith("_") and name in MEASURES:
@@ -92,6 +94,8 @@ class MeasureSet:
             doc[key] = self.value(key)
             if doc[key] is None:
                 reasons[key] = self.reason(key)
+        if self.model != "yaw_plane":                 # the default's JSON as it always was
+            doc = {"model": self.model, **doc}
         doc["reasons"] = reasons
         return doc
 
@@ -159,15 +163,50 @@ def residual_force(vehicle: Vehicle, load_units=None, sources=None, tire_scale: 
     return F
 
 
+def model_case(vehicle, model: str | None) -> tuple[Vehicle, str, dict]:
+    """(vehicle, model name, model options) of ``vehicle`` -- a :class:`Vehicle` (the model
+    ``model``, default the yaw plane) or a model object
+    (:class:`~lcvreport.model.base.VehicleModel`: its vehicle, name and options)."""
+    from ..model.base import MODELS, check_model
+    if hasattr(vehicle, "derivatives") and hasattr(vehicle, "vehicle"):
+        name = getattr(vehicle, "name", "yaw_plane")
+        if model is not None and check_model(model) != name:
+            raise ValueError(f"model must be the model object's own ({name!r}) or None, got {model!r}")
+        options = {"tire": vehicle.tire} if name == "nonlinear" else {}
+        return vehicle.vehicle, name, options
+    return vehicle, ("yaw_plane" if model is None else check_model(model, MODELS)), {}
+
+
+def _family_values(family, case: MeasureCase, model: str, asked: bool) -> tuple[dict, dict]:
+    """(values, reasons) of ``family`` for ``case`` on the model axis ``model``: computed on the
+    model :meth:`~lcvreport.measures.registry.Family.model_for` gives, or null with its reason;
+    a family computed on request only when ``asked``."""
+    import dataclasses
+    if family.on_request and not asked:
+        return dict.fromkeys(family.keys), dict.fromkeys(family.keys, ON_REQUEST)
+    on, why = family.model_for(model)
+    if on is None:
+        return dict.fromkeys(family.keys), ({"trim": why} if family.needs == "sources" else dict.fromkeys(family.keys, why))
+    if not family.applies(case):
+        return {}, {}
+    sub = case if on == case.model else dataclasses.replace(case, model=on)
+    values, why = family.compute(sub)
+    if sub is not case:
+        case.shared.update(sub.shared)
+    return values, why
+
+
 @one_blas_thread
 def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, load_units=None,
-                f_hz: float = RA_FREQUENCY_HZ, sources=None, conditions: dict | None = None) -> MeasureSet:
+                f_hz: float = RA_FREQUENCY_HZ, sources=None, conditions: dict | None = None,
+                model: str | None = None) -> MeasureSet:
     """Every measure of the registry (``docs/measures.md``) of ``vehicle`` at ``speed_mps`` [m/s]:
     each family of :data:`lcvreport.measures.registry.FAMILIES` in turn.
 
     Parameters
     ----------
-    vehicle : Vehicle
+    vehicle : Vehicle or VehicleModel
+        A vehicle (its model ``model``) or a model object (:func:`lcvreport.model.base.build_model`).
     speed_mps : float
     tire_scale : float
     load_units : list of str, optional
@@ -183,6 +222,14 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
         ``steady_turn_radius_m``, the low-speed turn's ``turn_radius_m`` and ``turn_angle_deg``);
         each one not given at its default.  (The speed is ``speed_mps``, the RA frequency
         ``f_hz``, the crossfall a residual source.)
+    model : str, optional
+        The model of the model-axis families (a key of :data:`lcvreport.model.base.MODELS`;
+        default the yaw plane): their keys are model-neutral, each family computed on what it
+        requires of the model (:func:`lcvreport.measures.registry.model_of_family`) --
+        ``model="yaw_roll"`` gives ``hsto_m`` equal to the default's ``hsto_m_roll``;
+        ``"nonlinear"`` the response families of the nonlinear model, its linearization's
+        eigenvalues, and its friction demand (docs/model.md#the-model-object).  The families of a
+        fixed model (the low-speed turn, the roll measures) are the same whatever ``model``.
 
     Examples
     --------
@@ -193,36 +240,35 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
     >>> round(m.hsso_m, 4) == round(m.values["hsso_m"], 4)
     True
     """
+    vehicle, model, options = model_case(vehicle, model)
     check_vehicle(vehicle)
     units = _load_units(vehicle, load_units)
     conditions = check_conditions(conditions)
     case = MeasureCase(vehicle, float(speed_mps), float(tire_scale), float(f_hz),
-                       residual_force(vehicle, units, sources, tire_scale), conditions=conditions)
+                       residual_force(vehicle, units, sources, tire_scale), conditions=conditions, model=model,
+                       options=options)
     values, undefined = {}, {}
     # each family keeps only its numbers: a manoeuvre's response (up to a megabyte of samples) is
     # freed before the next one is computed (a smaller heap, which malloc does not hand back)
     for family in FAMILIES.values():
-        if family.on_request:
-            values.update(dict.fromkeys(family.keys))
-            undefined.update(dict.fromkeys(family.keys, ON_REQUEST))
-        elif family.applies(case):
-            v, why = family.compute(case)
-            values.update(v)
-            undefined.update(why)
+        v, why = _family_values(family, case, model, asked=family.model == model)
+        values.update(v)
+        undefined.update(why)
     return MeasureSet(vehicle=vehicle, speed_mps=float(speed_mps), tire_scale=float(tire_scale), f_hz=float(f_hz),
                       load_units=units, sources=sources, values=values, undefined=undefined,
-                      trim=case.shared.get("trim"), conditions=conditions)
+                      trim=case.shared.get("trim"), conditions=conditions, model=model)
 
 
 @one_blas_thread
 def measure_values(vehicle: Vehicle, speed_mps: float, keys, tire_scale: float = 1.0, load_units=None,
                    f_hz: float = RA_FREQUENCY_HZ, sources=None, conditions: dict | None = None,
-                   reasons: dict | None = None) -> dict:
+                   reasons: dict | None = None, model: str | None = None) -> dict:
     """The values of the registry keys ``keys`` only, as :func:`measure_set` gives them (None
     where undefined), computing just their families (and those they take a result from: the yaw
     damping compares with the least damping ratio) -- what a study computes case by case and
-    an assessment per set of conditions.  ``conditions`` as :func:`measure_set`'s; ``reasons``,
-    a dict, receives why each null is null.
+    an assessment per set of conditions.  ``conditions`` and ``model`` as :func:`measure_set`'s
+    (a family computed on request is computed when one of its keys is asked for); ``reasons``, a
+    dict, receives why each null is null.
 
     Examples
     --------
@@ -231,21 +277,23 @@ def measure_values(vehicle: Vehicle, speed_mps: float, keys, tire_scale: float =
     >>> measure_values(v, 24.4, ["hsso_m"])["hsso_m"] == measure_set(v, 24.4).hsso_m
     True
     """
+    vehicle, model, options = model_case(vehicle, model)
     check_vehicle(vehicle)
     units = _load_units(vehicle, load_units)
     case = MeasureCase(vehicle, float(speed_mps), float(tire_scale), float(f_hz),
-                       residual_force(vehicle, units, sources, tire_scale), conditions=check_conditions(conditions))
+                       residual_force(vehicle, units, sources, tire_scale), conditions=check_conditions(conditions),
+                       model=model, options=options)
     needed = {MEASURES[k].family for k in keys if MEASURES[k].family}
     if "yaw_damping" in needed:
         needed.add("least_damping")
     values, why = {}, {}
     for name, family in FAMILIES.items():
-        if name in needed and family.applies(case):
-            v, w = family.compute(case)
+        if name in needed:
+            v, w = _family_values(family, case, model, asked=True)
             values.update(v)
             why.update(w)
     if reasons is not None:
-        probe = MeasureSet(vehicle=vehicle, speed_mps=float(speed_mps), values=values, undefined=why)
+        probe = MeasureSet(vehicle=vehicle, speed_mps=float(speed_mps), values=values, undefined=why, model=model)
         reasons.update({k: probe.reason(k) for k in keys if values.get(k) is None})
     return {k: values.get(k) for k in keys}
 

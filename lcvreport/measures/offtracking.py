@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.batch import RESPONSE_GROUP, VariantBatch
-from ..analysis.exact import ManoeuvreError, ManoeuvreResponse, check_lane_change_steer, response
+from ..analysis.exact import ManoeuvreError, ManoeuvreResponse, check_lane_change_steer
 from ..analysis.steady import check_trim, steady_with_yaw_rate, trim
 from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
 from ..model.linear import check_speed, check_tire_scale, linear_model
@@ -81,10 +81,16 @@ def lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float =
 
 
 def _lane_change_of(vehicle: Vehicle, speed_mps: float, steer, until_s: float, tire_scale: float,
-                    model: str) -> LaneChangeMeasures:
-    """HSTO and RA of a lane change ``steer`` (open or closed loop) over 0 <= t <= until_s + 8 s."""
+                    model: str, options: dict | None = None) -> LaneChangeMeasures:
+    """HSTO and RA of a lane change ``steer`` (open or closed loop) over 0 <= t <= until_s + 8 s,
+    on the model ``model`` (:func:`lcvreport.analysis.respond.respond`)."""
+    from ..analysis.integrate import IntegrationError
+    from ..analysis.respond import respond
     t_end = round((until_s + LANE_CHANGE_TAIL_S) / DT_S) * DT_S
-    r = response(vehicle, speed_mps, steer, t_end, DT_S, tire_scale=tire_scale, model=model)
+    try:
+        r = respond(vehicle, model, steer, speed_mps, t_end, DT_S, tire_scale, options=options)
+    except IntegrationError as exc:
+        raise ManoeuvreError(str(exc)) from None
     offset = lane_change_offset_m(steer)
     rear = vehicle.units[-1].rearmost_axle.name
     steered = max(vehicle.steered_axles, key=lambda a: a.x_m).name
@@ -100,7 +106,7 @@ def _lane_change_of(vehicle: Vehicle, speed_mps: float, steer, until_s: float, t
 def driver_lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
                                 accel_g: float = LANE_CHANGE[0], f_hz: float = LANE_CHANGE[1],
                                 gain_rad_per_m: float | None = None, preview_s: float | None = None,
-                                model: str = "yaw_plane") -> LaneChangeMeasures:
+                                model: str = "yaw_plane", options: dict | None = None) -> LaneChangeMeasures:
     """HSTO and RA in the closed-loop lane change ``driver:A0:F:K:T`` (docs/measures.md): the
     preview driver steers the tractor along the lane change's path; over 0 <= t <= T + 1/F +
     8 s, the largest overshoot of the last unit's rearmost axle beyond the path's final offset
@@ -115,7 +121,7 @@ def driver_lane_change_measures(vehicle: Vehicle, speed_mps: float, tire_scale: 
     K = DRIVER_GAIN_RAD_PER_M if gain_rad_per_m is None else float(gain_rad_per_m)
     T = DRIVER_PREVIEW_S if preview_s is None else float(preview_s)
     steer = driver_lane_change(accel_g * G_MPS2, f_hz, K, T)
-    return _lane_change_of(vehicle, speed_mps, steer, T + 1.0 / f_hz, tire_scale, model)
+    return _lane_change_of(vehicle, speed_mps, steer, T + 1.0 / f_hz, tire_scale, model, options)
 
 
 @dataclass(frozen=True)
@@ -315,10 +321,21 @@ def lane_change_family(case: MeasureCase) -> tuple[dict, dict]:
     keys = ("hsto_m", "ra_lane_change")
     try:
         lc = lane_change_measures(case.vehicle, case.speed_mps, case.tire_scale,
-                                  case.condition("lane_change_ay_g"), case.condition("lane_change_frequency_hz"))
+                                  case.condition("lane_change_ay_g"), case.condition("lane_change_frequency_hz"),
+                                  model=case.model)
     except ManoeuvreError as exc:
         return dict.fromkeys(keys), dict.fromkeys(keys, f"undefined: {exc}")
-    return {"hsto_m": lc.hsto_m, "ra_lane_change": lc.ra_lane_change}, {}
+    return {"hsto_m": lc.hsto_m, "ra_lane_change": _ra(case, lc, "ra_lane_change_roll")}, {}
+
+
+def _ra(case: MeasureCase, lc: LaneChangeMeasures, roll_measure: str) -> float:
+    """A lane change's RA: max|a_N| / max|a_s| -- on the yaw-roll model between its reference
+    points (the conditions ``ra_numerator``, ``ra_denominator``; ``roll_measure``'s defaults)."""
+    if case.model != "yaw_roll":
+        return lc.ra_lane_change
+    from .ra_points import ra_points, rearward_amplification
+    points = ra_points(case.conditions.get("ra_numerator"), case.conditions.get("ra_denominator"), roll_measure)
+    return rearward_amplification(lc.response, case.vehicle.n_units, *points)
 
 
 def driver_lane_change_family(case: MeasureCase) -> tuple[dict, dict]:
@@ -328,10 +345,11 @@ def driver_lane_change_family(case: MeasureCase) -> tuple[dict, dict]:
     try:
         lc = driver_lane_change_measures(case.vehicle, case.speed_mps, case.tire_scale,
                                          case.condition("lane_change_ay_g"), case.condition("lane_change_frequency_hz"),
-                                         case.condition("driver_gain_rad_per_m"), case.condition("driver_preview_s"))
+                                         case.condition("driver_gain_rad_per_m"), case.condition("driver_preview_s"),
+                                         model=case.model, options=case.model_options())
     except ManoeuvreError as exc:
         return dict.fromkeys(keys), dict.fromkeys(keys, f"undefined: {exc}")
-    return {"hsto_driver_m": lc.hsto_m, "ra_lane_change_driver": lc.ra_lane_change}, {}
+    return {"hsto_driver_m": lc.hsto_m, "ra_lane_change_driver": _ra(case, lc, "ra_lane_change_roll")}, {}
 
 
 def steady_turn_family(case: MeasureCase) -> tuple[dict, dict]:

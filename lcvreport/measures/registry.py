@@ -52,6 +52,46 @@ if TYPE_CHECKING:                                # annotations only: the registr
 #: why a measure computed on request is null in a measure set that did not ask for it
 ON_REQUEST = ("computed on request (it takes seconds): lcv measures --model nonlinear, a scheme or a study that "
               "names it, or measure_values with its key")
+#: the integration tolerance of a measure's manoeuvre on a model that is not linear: its measures
+#: agree with rtol 1e-8's to 1e-7 relative (tests/test_model_axis.py), at half the evaluations
+MEASURE_RTOL = 1e-6
+#: why the lane change of the inverse system is null on a model that is not linear
+INVERSE_ONLY = ("undefined on the {model} model: the lane change prescribes the steered axle's acceleration through the "
+                "inverse system, which only a linear model has; the closed-loop lane change (hsto_driver_m) is this "
+                "model's")
+#: why the steady-state families are null on a model other than the yaw plane
+STEADY_ONLY = ("not computed on the {model} model: the steady turn, the straight path and the trim solve the yaw "
+               "plane's steady-state equations (docs/measures.md); lcv measures without --model gives them")
+
+
+def model_of_family(family: "Family", model: str) -> tuple[str | None, str | None]:
+    """The model ``family`` is computed on when a case's model is ``model`` (a key of
+    :data:`lcvreport.model.base.MODELS`), or None with the reason: a family of a fixed model
+    (the low-speed turn, the roll families, the friction demand) on its own; one of the model
+    axis by what it ``requires`` -- ``linear``: a linear model itself, another model's
+    linearization at straight running (the nonlinear model's is the yaw plane: docs/nonlinear.md
+    #reduction-checks); ``response``: the model itself; ``inverse``: a linear model only;
+    ``steady``: the yaw plane only.
+
+    Examples
+    --------
+    >>> model_of_family(FAMILIES["least_damping"], "nonlinear")
+    ('yaw_plane', None)
+    >>> model_of_family(FAMILIES["lane_change"], "nonlinear")[0] is None
+    True
+    """
+    if family.model != "yaw_plane" or not family.requires:
+        return family.model, None
+    linear = model in ("yaw_plane", "yaw_roll")
+    if family.requires == "linear":
+        return (model if linear else "yaw_plane"), None
+    if family.requires == "response":
+        return model, None
+    if family.requires == "inverse":
+        return (model, None) if linear else (None, INVERSE_ONLY.format(model=model.replace("_", "-")))
+    return (model, None) if model == "yaw_plane" else (None, STEADY_ONLY.format(model=model.replace("_", "-")))
+
+
 #: why a family whose equations are singular for the vehicle is null
 NO_STEADY_STATE = ("undefined: its equations have no solution for this vehicle (singular: a unit whose tires cannot "
                    "hold both its lateral force and its yaw moment, such as a rigid unit on one axle)")
@@ -76,6 +116,19 @@ class MeasureCase:
     #: the conditions other than the speed (:data:`CONDITIONS` keys); a key not given takes
     #: its default (``ra_frequency_hz`` is ``f_hz``)
     conditions: dict = field(default_factory=dict)
+    #: the model the family is computed on (a key of :data:`lcvreport.model.base.MODELS`; the
+    #: measure set sets it per family: :func:`model_of_family`)
+    model: str = "yaw_plane"
+    #: the model's options (the nonlinear model's ``tire``)
+    options: dict = field(default_factory=dict)
+
+    def model_options(self) -> dict:
+        """The options :func:`lcvreport.model.base.build_model` takes for :attr:`model`: the
+        nonlinear model's tire law and its friction coefficient (the condition)."""
+        if self.model != "nonlinear":
+            return {}
+        return {"tire": self.options.get("tire", "saturating"),
+                "friction_coefficient": self.condition("friction_coefficient"), "rtol": MEASURE_RTOL}
 
     def condition(self, key: str, measure: str | None = None):
         """The value of the condition ``key`` in its unit (:data:`CONDITIONS`); a choice (an RA
@@ -114,6 +167,14 @@ class Family:
     #: computed only when asked for (by key, a scheme, a study, its model's ``lcv measures``), not in
     #: every measure set: the nonlinear model's turn takes seconds
     on_request: bool = False
+    #: what it needs of the model (a family of the model axis, ``model = "yaw_plane"``): ``linear``,
+    #: ``response``, ``inverse`` or ``steady`` (:func:`model_of_family`); "" for a family of a fixed model
+    requires: str = ""
+
+    def model_for(self, model: str) -> tuple[str | None, str | None]:
+        """(the model this family is computed on when the case's model is ``model``, or None; why
+        not, or None): see :func:`model_of_family`."""
+        return model_of_family(self, model)
 
     @property
     def keys(self) -> tuple[str, ...]:
@@ -292,6 +353,29 @@ RENAMED = {"trim_delta_rad": "trim.delta_rad", "trim_offtracking_m": "trim.offtr
 HINTS = {"tail_swing_m": "max_tail_swing_m"}
 #: both, for the messages
 ALIASES = {**RENAMED, **HINTS}
+#: the keys that carry their model in their name: (model-neutral key, model) -> today's key.  Each
+#: is the neutral key on that model (``measure_set(v, u, model="yaw_roll")["hsto_m"]`` is the
+#: default's ``hsto_m_roll``); the named keys stay, so every scheme, study and JSON consumer of an
+#: earlier release keeps working (docs/model.md#the-model-object).
+MODEL_KEYS = {("least_damping_ratio", "yaw_roll"): "roll_least_damping_ratio",
+              ("critical_speed_kph", "yaw_roll"): "roll_critical_speed_kph",
+              ("ra_single_sine", "yaw_roll"): "ra_single_sine_roll",
+              ("ra_lane_change", "yaw_roll"): "ra_lane_change_roll",
+              ("hsto_m", "yaw_roll"): "hsto_m_roll"}
+
+
+def model_key(key: str, model: str) -> tuple[str, str]:
+    """(key, model) of a measure taken on ``model``: a model-neutral key on the yaw-roll model is
+    today's key of it (:data:`MODEL_KEYS`: ``("hsto_m", "yaw_roll")`` -> ``("hsto_m_roll",
+    "yaw_plane")``, the yaw-roll family computing it whatever the axis), any other as given.
+
+    Examples
+    --------
+    >>> model_key("hsto_m", "yaw_roll"), model_key("hsto_driver_m", "nonlinear")
+    (('hsto_m_roll', 'yaw_plane'), ('hsto_driver_m', 'nonlinear'))
+    """
+    named = MODEL_KEYS.get((key, model))
+    return (named, "yaw_plane") if named is not None else (key, model)
 
 
 def canonical(key: str) -> str:

@@ -24,6 +24,7 @@ from ..model.yaw_roll.parameters import G_MPS2, missing_roll_data
 from ..util.threads import one_blas_thread
 from .amplification import single_sine
 from .offtracking import LANE_CHANGE, lane_change_measures
+from .ra_points import RA_POINTS, ra_points, rearward_amplification  # noqa: F401 (their home before)
 from .registry import NO_STEER, MeasureCase
 from .rollover import RolloverThreshold, rollover_threshold
 from .stability import CRITICAL_SPEED_MAX_KPH, critical_speed, least_damping
@@ -51,28 +52,6 @@ def roll_gains(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> n
 def ltr_peaks(response, n_groups: int) -> list[float]:
     """max over the response of |LTR| of every group, front to rear [-]."""
     return [float(x) for x in response.peaks_abs([f"ltr{g + 1}" for g in range(n_groups)])]
-
-
-#: the signal of each RA reference point in a yaw-roll response (docs/measures.md#roll-measures):
-#: the rearmost unit's sprung CG ``as<N>`` or roll-axis point ``ay<N>``; the hauling unit's
-#: steered axle ``a_steer`` or CG ``ay1``
-RA_POINTS = {"sprung_cg": "as{n}", "roll_axis": "ay{n}", "steer_axle": "a_steer", "cg": "ay1"}
-
-
-def ra_points(numerator: str | None, denominator: str | None, measure: str) -> tuple[str, str]:
-    """(numerator, denominator) of an RA measure: the points given, each missing one at the
-    measure's default (:func:`~lcvreport.measures.registry.default_condition`)."""
-    from .registry import default_condition
-    return (numerator or default_condition("ra_numerator", measure),
-            denominator or default_condition("ra_denominator", measure))
-
-
-def rearward_amplification(response, n_units: int, numerator: str, denominator: str) -> float:
-    """max|numerator| / max|denominator| over a yaw-roll ``response`` (the points' signals
-    located on the continuous response: :data:`RA_POINTS`)."""
-    top, bottom = (RA_POINTS[p].format(n=n_units) for p in (numerator, denominator))
-    peaks = response.peaks_abs([top, bottom])
-    return float(peaks[0] / peaks[1])
 
 
 def ltr_single_sine(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, f_hz: float = LANE_CHANGE[1],

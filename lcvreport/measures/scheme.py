@@ -21,7 +21,10 @@ depends on (``speed_kph`` is required where the measure depends on the speed, th
 default to the values ``docs/measures.md`` defines the measure at).  A limit is ``min``
 or ``max`` -- the kind the registry gives the measure (a larger HSTO is worse: a ``max``) --
 a number or ``"<factor> * <measure key>"``, with ``abs = true`` on |value| and an optional
-``source`` of its own.  No limits are built in.
+``source`` of its own.  No limits are built in.  A measure of the manoeuvres and eigenvalues
+may name the model it is taken on (``model = "nonlinear"``; default the yaw plane; ``hsto_m`` with
+``model = "yaw_roll"`` is ``hsto_m_roll``) and models whose value is shown beside it, not judged
+(``beside = ["nonlinear"]``: where the linear answer stops being true).
 
 Examples
 --------
@@ -46,7 +49,7 @@ from ..ranges import RangeError
 from ..util.files import FileInputError, loads_toml, read_toml_file
 from ..util.text import control_character, listed, named, shown
 from .criteria import CriteriaError, Limit, Relative, _relative
-from .registry import CONDITIONS, CRITERIA_KEYS, MEASURES, canonical, default_condition, unknown_key_message
+from .registry import CONDITIONS, CRITERIA_KEYS, MEASURES, canonical, default_condition, model_key, unknown_key_message
 
 #: the keys of a scheme file's top level
 TOP_KEYS = ("scheme", "levels", "description", "status", "measures")
@@ -78,6 +81,11 @@ class SchemeMeasure:
     key: str
     conditions: dict
     limits: dict
+    #: the model of the model axis it is taken on (``model = "nonlinear"`` in its entry; default the
+    #: yaw plane; a neutral key on the yaw-roll model is its ``*_roll`` key on the default)
+    model: str = "yaw_plane"
+    #: the models whose value is shown beside the judged one, not judged (``beside = ["nonlinear"]``)
+    beside: tuple = ()
 
     @property
     def speed_kph(self) -> float | None:
@@ -168,7 +176,8 @@ def _scheme(doc: dict, path: str) -> Scheme:
     keys = [m.key for m in measures]
     twice = next((k for k in keys if keys.count(k) > 1), None)
     if twice is not None:
-        raise SchemeError(f"measures.{twice}: named twice (once by an alias of an earlier release)")
+        raise SchemeError(f"measures.{twice}: named twice (once by an alias of an earlier release, or as the "
+                          "model-neutral key with model = \"yaw_roll\")")
     known = {m.key: m for m in measures}
     for m in measures:
         for ref in m.references:
@@ -191,11 +200,14 @@ def _measure(key: str, entry, levels: list) -> SchemeMeasure:
                           f"limit; the scalar measures: {', '.join(CRITERIA_KEYS)}")
     if not isinstance(entry, dict):
         raise SchemeError(f"{where}: a table (conditions, source, levels)")
+    model, beside = _models(key, entry, where)
+    key, model = model_key(key, model)
+    where = f"measures.{key}"
     m = MEASURES[key]
     allowed = m.conditions
     conditions = {}
     for name, value in entry.items():
-        if name in ("source", "levels"):
+        if name in ("source", "levels", "model", "beside"):
             continue
         if name not in allowed:
             what = (f"{key} depends on {', '.join(allowed)}" if allowed else f"{key} depends on no condition")
@@ -231,7 +243,34 @@ def _measure(key: str, entry, levels: list) -> SchemeMeasure:
             raise SchemeError(f"{where}.levels: no limit for level {level!r}; give one for every level "
                               f"({listed(levels, what='levels')})")
         limits[level] = _limit(key, f"{where}.levels.{level}", table[level], source)
-    return SchemeMeasure(key, conditions, limits)
+    return SchemeMeasure(key, conditions, limits, model, beside)
+
+
+def _models(key: str, entry: dict, where: str) -> tuple[str, tuple]:
+    """(model, beside) of a scheme entry: ``model`` (one of the models; only a measure of the
+    model axis takes one) and ``beside`` (the models whose value is shown beside, a list)."""
+    from ..model.base import MODELS
+    from .registry import FAMILIES
+    family = FAMILIES[MEASURES[key].family]
+    axis = family.model == "yaw_plane" and bool(family.requires)
+    model = entry.get("model", "yaw_plane")
+    if not isinstance(model, str) or model.replace("-", "_") not in MODELS:
+        raise SchemeError(f"{where}.model: one of {', '.join(MODELS)}, got {shown(str(model))}")
+    model = model.replace("-", "_")
+    beside = entry.get("beside", [])
+    if isinstance(beside, str):
+        beside = [beside]
+    if not isinstance(beside, list) or not all(isinstance(b, str) and b.replace("-", "_") in MODELS for b in beside):
+        raise SchemeError(f"{where}.beside: a list of models ({', '.join(MODELS)}), got {shown(str(beside))}")
+    beside = tuple(dict.fromkeys(b.replace("-", "_") for b in beside if b.replace("-", "_") != model))
+    if (model != "yaw_plane" or beside) and not axis:
+        raise SchemeError(f"{where}.model: {key} is a measure of the {family.model.replace('_', '-')} model only; "
+                          "model and beside are for the measures of the manoeuvres and eigenvalues (docs/model.md)")
+    for m in (model, *beside):
+        on, why = family.model_for(m)
+        if on is None:
+            raise SchemeError(f"{where}.{'model' if m == model else 'beside'}: {key} is {why}")
+    return model, beside
 
 
 def _limit(key: str, where: str, spec, source: str | None) -> Limit:

@@ -310,7 +310,7 @@ def _critical_speed_batched(batch: VariantBatch, tire_scale: float = 1.0, u_min_
 
 def least_damping_family(case: MeasureCase) -> tuple[dict, dict]:
     """The registry's ``least_damping`` family of one case: (values, reasons)."""
-    zeta, f_hz = least_damping(case.vehicle, case.speed_mps, case.tire_scale)
+    zeta, f_hz = least_damping(case.vehicle, case.speed_mps, case.tire_scale, model=case.model)
     case.shared["least_damping_ratio"] = zeta
     keys = ("least_damping_ratio", "least_damped_frequency_hz")
     return dict(zip(keys, (zeta, f_hz))), ({} if zeta is not None else {k: "no mode oscillates" for k in keys})
@@ -318,7 +318,7 @@ def least_damping_family(case: MeasureCase) -> tuple[dict, dict]:
 
 def critical_speed_family(case: MeasureCase) -> tuple[dict, dict]:
     """The registry's ``critical_speed`` family of one case: (values, reasons)."""
-    v = critical_speed(case.vehicle, case.tire_scale)
+    v = critical_speed(case.vehicle, case.tire_scale, model=case.model)
     why = {} if v is not None else {
         "critical_speed_kph": f"stable at every speed up to {CRITICAL_SPEED_MAX_KPH:g} km/h"}
     return {"critical_speed_kph": v}, why

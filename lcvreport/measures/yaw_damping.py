@@ -19,9 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.batch import RESPONSE_GROUP, VariantBatch
-from ..analysis.exact import ManoeuvreResponse, response
+from ..analysis.exact import ManoeuvreResponse
 from ..manoeuvres.steer import pulse
-from ..model.linear import linear_model
 from ..model.vehicle import Vehicle
 from .registry import MeasureCase
 
@@ -115,31 +114,35 @@ def ratio_damping(extrema_values) -> tuple[float | None, np.ndarray]:
 
 
 def yaw_damping_coefficient(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
-                            model: str = "yaw_plane") -> YawDamping:
+                            model: str = "yaw_plane", options: dict | None = None) -> YawDamping:
     """PBS-style yaw damping: the pulse ``pulse:0.01:0.5``; for each joint the extrema of
     its articulation angle from the end of the pulse to 40 s after (zeros of theta',
     located on the continuous response), their peak-to-peak amplitudes P_i = |A_(i+1) -
     A_i|, the first six of those >= 5 % of the joint's largest; each consecutive pair
     gives zeta = d / sqrt(pi^2 + d^2), d = ln(P_i / P_(i+1)); a joint's value is the mean
     of its pairs; the coefficient the smallest over joints with two amplitudes or more.
-    On the linear model ``model`` (default the yaw plane).
+    On the model ``model`` (default the yaw plane; a model that is not linear integrated, its
+    modal damping ratio its linearization's).
     """
+    from ..model.base import LINEAR_MODELS
     from .stability import least_damping
-    return _yaw_damping(vehicle, speed_mps, tire_scale, least_damping(vehicle, speed_mps, tire_scale, model)[0],
-                        model)
+    linear = model if model in LINEAR_MODELS else "yaw_plane"
+    return _yaw_damping(vehicle, speed_mps, tire_scale, least_damping(vehicle, speed_mps, tire_scale, linear)[0],
+                        model, options)
 
 
 def _yaw_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float, zeta_modal: float | None,
-                 model: str = "yaw_plane") -> YawDamping:
+                 model: str = "yaw_plane", options: dict | None = None) -> YawDamping:
     """:func:`yaw_damping_coefficient` with the modal least damping ratio already known."""
     A, D = YDC_PULSE
     steer = pulse(A, D)
     t_end = round((D + YDC_WINDOW_S) / YDC_DT_S) * YDC_DT_S
-    r = response(vehicle, speed_mps, steer, t_end, YDC_DT_S, tire_scale=tire_scale, model=model)
+    from ..analysis.respond import respond
+    r = respond(vehicle, model, steer, speed_mps, t_end, YDC_DT_S, tire_scale, options=options)
     if vehicle.n_units < 2:
         return YawDamping(None, [], [], [], zeta_modal, r, "no joint: a single unit has no articulation angle")
     per_joint, amps, ext = [], [], []
-    joints = [n for n in linear_model(vehicle, model).state_names if n.startswith("theta")]
+    joints = [f"theta{c}" for c in vehicle.joint_letters]
     for t, v in r.extrema_many(joints, D, D + YDC_WINDOW_S):
         inner = (t > D + 1e-12) & (t < D + YDC_WINDOW_S - 1e-12)     # the window's ends are not extrema
         t, v = t[inner], v[inner]
@@ -259,8 +262,10 @@ def yaw_damping_family(case: MeasureCase) -> tuple[dict, dict]:
     zeta = case.shared.get("least_damping_ratio")
     if "least_damping_ratio" not in case.shared:
         from .stability import least_damping
-        zeta = least_damping(case.vehicle, case.speed_mps, case.tire_scale)[0]
-    ydc = _yaw_damping(case.vehicle, case.speed_mps, case.tire_scale, zeta)
+        from ..model.base import LINEAR_MODELS
+        zeta = least_damping(case.vehicle, case.speed_mps, case.tire_scale,
+                             case.model if case.model in LINEAR_MODELS else "yaw_plane")[0]
+    ydc = _yaw_damping(case.vehicle, case.speed_mps, case.tire_scale, zeta, case.model, case.model_options())
     why = {}
     if ydc.value is None:
         why["yaw_damping_coefficient"] = f"undefined: {ydc.why}"

@@ -375,7 +375,11 @@ def _run_distributed(study, todo, bounds, chunks, workers, scheduler, bar) -> No
     import logging
 
     from dask.distributed import Client, LocalCluster, as_completed
-    logging.getLogger("distributed").setLevel(logging.CRITICAL)     # failures reach us through the futures
+    # failures reach us through the futures; an interrupt (Ctrl-C, a batch system's SIGTERM) that
+    # lands while the event loop runs a callback makes tornado log "Exception in callback" with a
+    # traceback on a loaded machine: the command's one line says it was interrupted
+    for name in ("distributed", "tornado", "asyncio"):
+        logging.getLogger(name).setLevel(logging.CRITICAL)
     doc = study.to_dict()
     cluster = None
     try:

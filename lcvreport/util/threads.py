@@ -72,13 +72,15 @@ _controllers: dict = {}
 
 
 def _controller():
-    """A threadpoolctl controller of the BLAS libraries loaded now (scipy's own OpenBLAS loads
-    with scipy.linalg: a new controller then)."""
-    key = "scipy.linalg" in sys.modules
-    c = _controllers.get(key)
+    """A threadpoolctl controller of the BLAS libraries, scipy's own OpenBLAS loaded first (it
+    loads with scipy.linalg: a block entered before it loaded left it unlimited, and a first
+    computation inside a block -- solve_ivp imports scipy.linalg -- differed from the second in
+    its last bits)."""
+    c = _controllers.get(True)
     if c is None:
+        import scipy.linalg  # noqa: F401  (its BLAS among those limited)
         from threadpoolctl import ThreadpoolController
-        c = _controllers[key] = ThreadpoolController()
+        c = _controllers[True] = ThreadpoolController()
     return c
 
 
