@@ -104,6 +104,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``description_fmi3`` the FMI 3.0 modelDescription.xml and buildDescription.xml
     ``driver``           the driver FMU (FMI 2.0 CS and ME, C99) of the preview driver
     ``engine``           the co-simulation engine (numpy only)
+    ``nonlinear_engine`` the nonlinear model's co-simulation engine: each step integrated
     ``slave_core``       what the Python FMUs compute, FMI calls by value reference onto the engine
     ``slave_fmi2``       the FMI 2.0 slave class: the core behind pythonfmu
     ``slave_fmi3``       the FMI 3.0 slave class: the core behind pythonfmu3

@@ -24,7 +24,8 @@ def interface_of(path: Path):
     root = ET.fromstring(zipfile.ZipFile(path).read("modelDescription.xml"))
     if "resources/vehicle.toml" in names:
         u_start = next(float(sv[0].get("start")) for sv in root.iter("ScalarVariable") if sv.get("name") == "u")
-        model = "yaw_roll" if any(sv.get("name") == "phi1" for sv in root.iter("ScalarVariable")) else "yaw_plane"
+        names = {sv.get("name") for sv in root.iter("ScalarVariable")}
+        model = "yaw_roll" if "phi1" in names else "nonlinear" if "friction_coefficient" in names else "yaw_plane"
         return vehicle_interface(loads_vehicle(zipfile.ZipFile(path).read("resources/vehicle.toml").decode()),
                                  u_start, model)
     if any(sv.get("name") == "preset" for sv in root.iter("ScalarVariable")):

@@ -223,3 +223,56 @@ def _position(model, x, linear: bool) -> tuple[float, float]:
     if linear:
         return float(x[-1]), float(x[-2])
     return float(x[1]), float(x[2])
+
+
+@one_blas_thread
+def integrate_step(model, x0, w, speed_mps: float, h: float, tire_scale: float = 1.0, rtol: float = RTOL,
+                   atol: float | None = None, max_evaluations: int = MAX_EVALUATIONS) -> np.ndarray:
+    """The state of ``model`` (not linear: its :attr:`state_names`) ``h`` [s] after ``x0`` with
+    the inputs ``w`` (the model's :attr:`input_names`) and the forward speed ``speed_mps`` [m/s]
+    held: one step of a co-simulation (the nonlinear FMU's), integrated as :func:`integrate`
+    integrates a run (Radau, ``rtol``, ``atol``, the same evaluation budget).
+
+    Raises
+    ------
+    IntegrationError
+        A driven axle out of friction (naming the axle), a failed integration.
+
+    Examples
+    --------
+    >>> from lcvreport.model.base import build_model
+    >>> from lcvreport.model.vehicle_file import load_vehicle
+    >>> m = build_model(load_vehicle("examples/vehicles/b_double.toml"), "nonlinear")
+    >>> w = m.zero_input(); w[0] = 0.01
+    >>> x = integrate_step(m, np.zeros(m.n_states), w, 25.0, 0.5)
+    >>> bool(x[m.state_names.index("r1")] > 0)                # 0.01 rad nose right: turning right
+    True
+    """
+    from scipy.integrate import solve_ivp
+    check_speed(speed_mps)
+    check_tire_scale(tire_scale)
+    u, w = float(speed_mps), np.asarray(w, dtype=float)
+    count = [0]
+
+    def rhs(t, z):
+        count[0] += 1
+        if count[0] > max_evaluations:
+            raise _Budget(t)
+        cols = z if z.ndim == 2 else z[:, None]
+        try:
+            out = model.derivatives(t, cols.T, w, u, tire_scale).T
+        except Exception as exc:                                  # the model's refusal, with the time
+            if type(exc).__name__ == "TractionError":
+                raise IntegrationError(f"at {t:.3f} s into the step: {exc}") from None
+            raise
+        return out if z.ndim == 2 else out[:, 0]
+
+    try:
+        sol = solve_ivp(rhs, (0.0, float(h)), np.asarray(x0, dtype=float), method="Radau", rtol=rtol,
+                        atol=ATOL if atol is None else atol, vectorized=True)
+    except _Budget:
+        raise IntegrationError(f"the step took more than {max_evaluations} evaluations of the model's equations "
+                               "(the run cannot be integrated further: a vehicle out of control?)") from None
+    if not sol.success:
+        raise IntegrationError(f"the integration failed: {sol.message}")
+    return sol.y[:, -1].copy()

@@ -34,7 +34,7 @@ def run_report(command: str, build, wrote) -> None:
 def _cmd_fmu(args, out: _Out) -> int:
     from ..fmu.build import build_vehicle_fmus
     from ..fmu.c_sources import FmuBuildError
-    from ..model.linear import check_model
+    from ..model.base import check_model
     model = check_model(args.model)
     if model == "yaw_roll":
         from ..measures.roll import unstable_at_rest
@@ -44,6 +44,18 @@ def _cmd_fmu(args, out: _Out) -> int:
         if why is not None:                     # its roll angle would grow without bound from any start
             raise UsageError(f"argument --model yaw-roll: {v.name}: {why.removeprefix('undefined: ')}; no FMU "
                              "was built")
+    elif model == "nonlinear":
+        if args.kind not in (None, "python") or str(args.fmi) != "2":
+            raise UsageError(f"argument --model nonlinear: its FMU is the Python FMI 2.0 one (--kind python, "
+                             f"--fmi 2), got --kind {args.kind or 'both'} --fmi {args.fmi}; no FMU was built")
+        from ..model.nonlinear.model import nonlinear_model
+        from ..model.vehicle import VehicleError
+        v = _vehicle(args)
+        try:
+            nonlinear_model(v)                  # every axle's static_load_N: one line naming the axle
+        except VehicleError as exc:
+            raise UsageError(f"argument --model nonlinear: {v.name}: {exc}; no FMU was built") from None
+        args.kind = "python"
     else:
         v = _vehicle(args)
     try:

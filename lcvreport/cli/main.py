@@ -185,10 +185,11 @@ def build_parser() -> argparse.ArgumentParser:
     fmu.add_argument("--fmi", default="2", choices=("2", "3"),
                      help="FMI version (default 2): <name>.fmu and <name>Native.fmu, or <name>3.fmu and "
                           "<name>Native3.fmu")
-    fmu.add_argument("--model", default="yaw-plane", choices=("yaw-plane", "yaw-roll"),
-                     help="the linear model built in (default yaw-plane); yaw-roll adds the roll states and the "
+    fmu.add_argument("--model", default="yaw-plane", choices=("yaw-plane", "yaw-roll", "nonlinear"),
+                     help="the model built in (default yaw-plane); yaw-roll adds the roll states and the "
                           "sprung accelerations, load transfers and LTRs as outputs, and needs the vehicle's roll "
-                          "keys (docs/roll.md)")
+                          "keys (docs/roll.md); nonlinear: the nonlinear planar model (docs/nonlinear.md), its "
+                          "Python FMI 2.0 Co-Simulation FMU <name>_nonlinear.fmu only")
     speed(fmu, required=False)
     rep = sub.add_parser("report", help="assessment report of the vehicle (HTML and PDF)")
     source(rep, masses=False)

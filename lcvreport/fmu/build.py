@@ -259,16 +259,26 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
     u_start_mps : float
         Start value of the input ``u`` [m/s] (default 50 mph).
     fmi : {2, 3}
-    model : {"yaw_plane", "yaw_roll"}
-        The linear model built in (:func:`~lcvreport.fmu.interface.vehicle_interface`).  The
+    model : {"yaw_plane", "yaw_roll", "nonlinear"}
+        The model built in (:func:`~lcvreport.fmu.interface.vehicle_interface`).  The
         yaw plane's FMUs are named for the vehicle, another model's for the vehicle and the model
-        (``<name>_yaw_roll.fmu``, ``<name>_yaw_rollNative.fmu``, ...): both kinds of one vehicle
-        sit in one folder and load into one host (their model identifiers differ).
+        (``<name>_yaw_roll.fmu``, ``<name>_yaw_rollNative.fmu``, ``<name>_nonlinear.fmu``, ...): every
+        kind of one vehicle sits in one folder and loads into one host (their model identifiers
+        differ).  The nonlinear model's FMU is the Python FMI 2.0 one only.
+
+    Raises
+    ------
+    ValueError
+        An unknown kind or FMI version; the nonlinear model with another kind or version.
     """
     if kind not in ("python", "native", "both"):
         raise ValueError(f"kind must be python, native or both, got {kind!r}")
     if fmi not in (2, 3):
         raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
+    from ..model.base import check_model
+    if check_model(model) == "nonlinear" and (kind != "python" or fmi != 2):
+        raise ValueError(f"the nonlinear model's FMU is the Python FMI 2.0 Co-Simulation one (kind='python', "
+                         f"fmi=2), got kind={kind!r}, fmi={fmi!r}: its steps are integrated by the package")
     itf = vehicle_interface(vehicle, u_start_mps, model)
     name = fmu_base_name(vehicle.name, model)
     out = []

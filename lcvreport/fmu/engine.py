@@ -89,6 +89,9 @@ class LCVEngine:
         For a bad parameter (the message names it and its range).
     """
 
+    #: exact steps of a linear model: outputs from output matrices (the slave's fast path)
+    linear = True
+
     def __init__(self, interface: Interface, preset: str | None = None, tire_scale: float = 1.0,
                  u_min: float = 2.2352, cache_size: int = 128, crossfall: float = 0.0):
         self.interface = interface

@@ -358,7 +358,8 @@ def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START, model: str
     variable, so their value references do not move) the roll rates ``p<i>`` [rad/s] and roll
     angles ``phi<i>`` [rad] of the sprung masses, the sprung CGs' lateral accelerations
     ``as<i>`` [m/s2], every axle's load transfer ``dFz_<axle>`` [N] and the load transfer ratio
-    ``ltr<g>`` [-] of every roll-coupled group.
+    ``ltr<g>`` [-] of every roll-coupled group; ``nonlinear``, the nonlinear planar model's
+    (:func:`nonlinear_interface`).
 
     Raises
     ------
@@ -374,6 +375,9 @@ def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START, model: str
     >>> [v.name for v in itf.outputs][-4:]
     ['dFz_dolly_axle', 'dFz_trailer2_axle', 'ltr1', 'ltr2']
     """
+    from ..model.base import check_model as check_any_model
+    if check_any_model(model) == "nonlinear":
+        return nonlinear_interface(vehicle, u_start_mps)
     from ..model.linear import check_model
     RANGES["speed"].check(u_start_mps, "start speed")
     model = check_model(model)
@@ -443,3 +447,81 @@ def vehicle_interface(vehicle: Vehicle, u_start_mps: float = U_START, model: str
             "tire forces (conicity, ply steer). Exact zero-order-hold stepping for any communication step size."
             + (f" {vehicle.description}" if vehicle.description else ""))
     return Interface(fmu_base_name(vehicle.name, model), tuple(t.vars), (vehicle,), False, desc, model)
+
+
+def nonlinear_interface(vehicle: Vehicle, u_start_mps: float = U_START) -> Interface:
+    """The interface of a vehicle's nonlinear-model FMU (``lcv fmu --model nonlinear``,
+    docs/fmu.md#the-nonlinear-model): the linear FMUs' parameters and the friction coefficient,
+    their inputs, and section 18's signals as outputs -- every CG's position, heading, lateral
+    velocity, yaw rate and lateral acceleration, the articulation angles, every axle's tire
+    forces, friction demand and lateral position, the rear end's.
+
+    Raises
+    ------
+    lcvreport.model.vehicle.VehicleError
+        An axle without ``static_load_N`` (the model needs the axle loads).
+
+    Examples
+    --------
+    >>> from lcvreport.model.vehicle_file import load_vehicle
+    >>> itf = nonlinear_interface(load_vehicle("examples/vehicles/b_double.toml"))
+    >>> itf.model_name, [v.name for v in itf.parameters]
+    ('b_double_nonlinear', ['tire_scale', 'u_min', 'crossfall', 'friction_coefficient'])
+    """
+    from ..model.nonlinear.model import nonlinear_model
+    RANGES["speed"].check(u_start_mps, "start speed")
+    nonlinear_model(vehicle)                          # the axle loads checked: one line naming the axle
+    t = _Table("si")
+    _parameters(t)
+    t.add("friction_coefficient", "parameter", "fixed", "factor", 0.8,
+          f"Tire-road friction coefficient mu of every tire (the brush tire's), in {RANGES['friction'].text()}",
+          ("parameter", "friction_coefficient"), range_key="friction")
+    steered = vehicle.steered_axles
+    steer_text = ("axles " + ", ".join(a.name for a in steered)) if steered else "no axle (none is steered)"
+    _speed_and_steer(t, steer_text, float(u_start_mps))
+    for kind, what, quantity, rng in (("P", "Residual lateral force (conicity, ply steer)", "force", "residual_force"),
+                                      ("T", "Residual aligning moment, about +z (down)", "moment", "residual_moment"),
+                                      ("eps", "Misalignment (thrust angle), nose-right positive", "angle",
+                                       "misalignment")):
+        for i, u in enumerate(vehicle.units):
+            for a in u.axles:
+                t.add(f"{kind}_{a.name}", "input", "continuous", quantity, 0.0,
+                      f"{what} of axle {a.name} of {u.name} (unit {i + 1})", (kind, a.name), range_key=rng)
+    units = list(enumerate(vehicle.units))
+    for sym, quantity, text in (("X", "length", "Ground position of the CG of {u} along the start heading"),
+                                ("Y", "length", "Ground position of the CG of {u} to the right of the start heading"),
+                                ("psi", "angle", "Heading of {u} from the start heading, nose-right positive"),
+                                ("v", "speed", "Lateral velocity of the CG of {u} in its own axes, +y"),
+                                ("r", "rate", "Yaw rate of {u}, nose-right positive")):
+        for i, u in units:
+            t.add(f"{sym}{i + 1}", "output", "continuous", quantity, None, text.format(u=f"{u.name} (unit {i + 1})"),
+                  ("pose", f"{sym}{i + 1}"))
+    for k in range(vehicle.n_units - 1):
+        t.add(f"theta{k + 1}", "output", "continuous", "angle", None, f"Articulation angle at joint {k + 1} "
+              f"({vehicle.units[k].name} - {vehicle.units[k + 1].name}, heading of the unit ahead minus the unit "
+              "behind, any angle)", ("pose", f"theta{vehicle.joint_letters[k]}"))
+    for i, u in units:
+        t.add(f"ay{i + 1}", "output", "continuous", "accel", None, f"Lateral acceleration of the CG of {u.name} "
+              f"(unit {i + 1}) in its own axes, at the current state and inputs", ("ay", f"ay{i + 1}"))
+    for sym, quantity, text in (("Fx", "force", "Longitudinal tire force of axle {a} (all its tires, wheel axes): the "
+                                                "drive force that holds the speed on a driven axle, 0 elsewhere"),
+                                ("Fy", "force", "Lateral tire force of axle {a} (all its tires, wheel axes), +y"),
+                                ("fd", "factor", "Friction demand of axle {a}: sqrt(Fx^2 + Fy^2) / (mu Fz0), "
+                                                 "1 = saturated")):
+        for i, u in units:
+            for a in u.axles:
+                t.add(f"{sym}_{a.name}", "output", "continuous", quantity, None,
+                      text.format(a=f"{a.name} of {u.name} (unit {i + 1})") + ", at the current state and inputs",
+                      ("extra", f"{sym}_{a.name}"))
+    for i, u in units:
+        for a in u.axles:
+            t.add(f"Y_{a.name}", "output", "continuous", "length", None, f"Ground lateral position of the centre of "
+                  f"axle {a.name} of {u.name} (unit {i + 1}), +y", ("pose", f"Y_{a.name}"))
+    t.add("Y_rear", "output", "continuous", "length", None, f"Ground lateral position of the rear end of "
+          f"{vehicle.units[-1].name}, +y", ("pose", "Y_rear"))
+    n = vehicle.n_units
+    desc = (f"Nonlinear planar model of {vehicle.name} ({n} units: {', '.join(vehicle.unit_names)}): any articulation "
+            "angle, brush tires saturating at the friction coefficient, unit 1's speed held by its driven axles; "
+            "each communication step integrated (Radau, rtol 1e-8) with the inputs held."
+            + (f" {vehicle.description}" if vehicle.description else ""))
+    return Interface(fmu_base_name(vehicle.name, "nonlinear"), tuple(t.vars), (vehicle,), False, desc, "nonlinear")

@@ -30,8 +30,24 @@ def _interface(resources: str):
         cfg = json.load(f)
     if cfg["mode"] == "presets":
         return preset_interface()
+    if cfg.get("model") == "nonlinear":
+        from .interface import nonlinear_interface
+        return nonlinear_interface(load_vehicle(os.path.join(resources, cfg["vehicle_file"])),
+                                   cfg.get("u_start_mps", U_START))
     return vehicle_interface(load_vehicle(os.path.join(resources, cfg["vehicle_file"])),
                              cfg.get("u_start_mps", U_START), cfg.get("model", "yaw_plane"))
+
+
+def _engine(itf, params: dict):
+    """The engine of an interface's model with the parameters ``params``: the linear models' exact
+    stepping (:class:`LCVEngine`) or the nonlinear model's integration
+    (:class:`~lcvreport.fmu.nonlinear_engine.NonlinearEngine`)."""
+    if itf.model == "nonlinear":
+        from .nonlinear_engine import NonlinearEngine
+        return NonlinearEngine(itf, None, params["tire_scale"], params["u_min"], params.get("crossfall", 0.0),
+                               params["friction_coefficient"])
+    return LCVEngine(itf, params.get("preset"), params["tire_scale"], params["u_min"],
+                     crossfall=params.get("crossfall", 0.0))
 
 
 def _quietly(method):
@@ -116,8 +132,7 @@ class SlaveCore:
             if self.initialized:
                 self._error(f"{self._fn('ExitInitializationMode')} called twice; call {self._fn('Reset')} to start again")
                 return
-            self.engine = LCVEngine(self.itf, self.params.get("preset"), self.params["tire_scale"],
-                                    self.params["u_min"], crossfall=self.params["crossfall"])
+            self.engine = _engine(self.itf, self.params)
             self.init_error = None
             self.initialized = True
             self._values = None
@@ -229,6 +244,8 @@ class SlaveCore:
         one product ``V [z, w] + c`` (+ the rear-end offsets' sines) with ``V`` and ``c``
         kept per speed."""
         e = self.engine
+        if e is not None and not e.linear:      # an integrated model: its outputs, not output matrices
+            return self._all_values_checked()
         if e is not None and self._feed_problem is False:
             self._feed_problem = e.input_problem(self.inputs, speed=False)
         if e is None or self._feed_problem is not None:
@@ -387,10 +404,11 @@ class SlaveCore:
             engine = None
             if state["engine"] is not None:
                 engine = self.engine
-                if engine is None or (engine.preset, engine.tire_scale, engine.u_min, engine.crossfall) != \
-                        (params.get("preset"), params["tire_scale"], params["u_min"], params.get("crossfall", 0.0)):
-                    engine = LCVEngine(self.itf, params.get("preset"), params["tire_scale"], params["u_min"],
-                                       crossfall=params.get("crossfall", 0.0))
+                if engine is None or (engine.preset, engine.tire_scale, engine.u_min, engine.crossfall,
+                                      getattr(engine, "friction_coefficient", None)) != \
+                        (params.get("preset"), params["tire_scale"], params["u_min"], params.get("crossfall", 0.0),
+                         params.get("friction_coefficient")):
+                    engine = _engine(self.itf, params)
                 engine.set_state(state["engine"])
             self.params, self.inputs, self.engine = params, np.array(inputs, dtype=float), engine
             self._problem = self._feed_problem = False
