@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -55,7 +55,7 @@ from ..manoeuvres.paths import StraightArcPath
 from ..model.body import TurnError, _need_bodies, _need_tracks, corners, overall_length_m
 from ..model.low_speed.kinematics import KinematicRun, KinematicsError, integrate
 from ..model.vehicle import Vehicle
-from ..util.cache import memoized
+from ..util.cache import LRUCache
 from ..util.threads import one_blas_thread
 from .registry import MeasureCase
 
@@ -270,16 +270,44 @@ class _Probe:
     heading: object
 
 
-def _extreme(probe: _Probe, value, sign: float, s: np.ndarray, centre: np.ndarray, lo: float, hi: float):
+#: points per level of the refinement of an extreme or an edge crossing on the dense output
+#: (each level one vectorized evaluation; the bracket shrinks by half this per level)
+REFINE_POINTS = 513
+#: levels: an interior extreme's bracket of two grid steps (0.1 m) shrinks to 6e-9 m in s (the
+#: value's error is its curvature times the square of that), an edge crossing's to 4e-7 m and is
+#: then interpolated linearly in the unwrapped angle (error ~ curvature x 4e-7^2)
+EXTREME_LEVELS, EDGE_LEVELS = 3, 2
+#: how far below the best grid value another point's grid value may lie and still be refined [m]:
+#: the grid's value (the sector's edges interpolated linearly) is within max|f''| h^2 / 8 of the
+#: refined one over the grid step h = SAMPLE_M; measured on every preset and example at 90, 180,
+#: 360 and 1440 deg (1558 refinements): at most 9.8e-5 m -- the margin is 127 times that
+MARGIN_M = 0.0125
+
+
+def _best_of(probes, value, sign: float, s, centre, lo: float, hi: float):
+    """The extreme over ``probes`` (each ``(probe, name)``) as ``(value, s, name)`` or None: every
+    probe's grid extreme, then only those within :data:`MARGIN_M` of the best refined."""
+    grid = [(r, p, name) for p, name in probes if (r := _extreme(p, value, sign, s, centre, lo, hi, refine=False))]
+    if not grid:
+        return None
+    top = max(sign * r[0] for r, _p, _n in grid)
+    found = [(_extreme(p, value, sign, s, centre, lo, hi), name) for r, p, name in grid
+             if sign * r[0] >= top - MARGIN_M]
+    return max(((r[0], r[1], name) for r, name in found if r), key=lambda r: sign * r[0])
+
+
+def _extreme(probe: _Probe, value, sign: float, s: np.ndarray, centre: np.ndarray, lo: float, hi: float,
+             refine: bool = True):
     """The largest (``sign`` +1) or smallest (-1) of ``value(points)`` over the positions of
     ``probe`` whose unwrapped angle lies in [lo, hi]: interior extremes refined on the dense
     output, extremes on the sector's edges located on the edge.  None if no position is in it.
+    Every refinement is a few vectorized evaluations (a fine grid in the bracket, zoomed), not a
+    scalar search; ``refine=False``: the grid's extreme only (a bound within :data:`MARGIN_M`).
 
     Returns
     -------
     (value, s) or None
     """
-    from scipy.optimize import brentq, minimize_scalar
     pts = probe.points(s)
     phi = _unwrapped(pts, centre, probe.heading(s))
     vals = value(pts)
@@ -287,12 +315,8 @@ def _extreme(probe: _Probe, value, sign: float, s: np.ndarray, centre: np.ndarra
     if not inside.any():
         return None
 
-    def phi_at(x, _k=None):
-        xs = np.array([x])
-        return float(_unwrapped(probe.points(xs), centre, probe.heading(xs))[0])
-
-    def val_at(x):
-        return float(value(probe.points(np.array([x])))[0])
+    def phis(xs):
+        return _unwrapped(probe.points(xs), centre, probe.heading(xs))
 
     best = None
 
@@ -306,28 +330,88 @@ def _extreme(probe: _Probe, value, sign: float, s: np.ndarray, centre: np.ndarra
         i0, i1 = int(run[0]), int(run[-1])
         j = i0 + int(np.argmax(sign * vals[i0:i1 + 1]))
         offer(float(vals[j]), float(s[j]))
+        if not refine:                               # the edges' values interpolated on the grid
+            for a_i, b_i, inner in ((i0 - 1, i0, i0), (i1, i1 + 1, i1)):
+                if a_i < 0 or b_i >= s.size:
+                    continue
+                out = a_i if inner == b_i else b_i
+                edge = lo if phi[out] < lo else hi
+                w = (edge - phi[a_i]) / (phi[b_i] - phi[a_i]) if phi[b_i] != phi[a_i] else 0.0
+                offer(float(vals[a_i] + w * (vals[b_i] - vals[a_i])), float(s[a_i] + w * (s[b_i] - s[a_i])))
+            continue
         if i0 < j < i1:                              # inside the sector: refine between the neighbours
-            res = minimize_scalar(lambda x: -sign * val_at(x), bounds=(s[j - 1], s[j + 1]), method="bounded",
-                                  options={"xatol": 1e-9})
-            if np.isfinite(res.fun) and lo <= phi_at(res.x, j) <= hi:
-                offer(-sign * float(res.fun), float(res.x))
-        for a, b, inner in ((i0 - 1, i0, i0), (i1, i1 + 1, i1)):      # the edges the run crosses
-            if a < 0 or b >= s.size:
+            a, b = float(s[j - 1]), float(s[j + 1])
+            for _level in range(EXTREME_LEVELS):
+                xs = np.linspace(a, b, REFINE_POINTS)
+                p = probe.points(xs)
+                v = sign * value(p)
+                ok = np.isfinite(v)
+                if not ok.any():
+                    break
+                m = int(np.argmax(np.where(ok, v, -np.inf)))
+                ph = float(_unwrapped(p[m:m + 1], centre, probe.heading(xs[m:m + 1]))[0])
+                if lo <= ph <= hi:
+                    offer(sign * float(v[m]), float(xs[m]))
+                a, b = float(xs[max(m - 1, 0)]), float(xs[min(m + 1, xs.size - 1)])
+        for a_i, b_i, inner in ((i0 - 1, i0, i0), (i1, i1 + 1, i1)):      # the edges the run crosses
+            if a_i < 0 or b_i >= s.size:
                 continue
-            out = a if inner == b else b
+            out = a_i if inner == b_i else b_i
             edge = lo if phi[out] < lo else hi
-            x = brentq(lambda x: phi_at(x, inner) - edge, s[a], s[b], xtol=1e-12)
-            offer(val_at(x), x)
+            a, b = float(s[a_i]), float(s[b_i])
+            fa, fb = float(phi[a_i]) - edge, float(phi[b_i]) - edge
+            for _level in range(EDGE_LEVELS):
+                xs = np.linspace(a, b, REFINE_POINTS)
+                f = phis(xs) - edge
+                f[0], f[-1] = fa, fb
+                c = int(np.flatnonzero(np.sign(f[:-1]) != np.sign(f[1:]))[0]) if np.any(
+                    np.sign(f[:-1]) != np.sign(f[1:])) else 0
+                a, b, fa, fb = float(xs[c]), float(xs[c + 1]), float(f[c]), float(f[c + 1])
+            x = a if fb == fa else a + (b - a) * (-fa) / (fb - fa)       # the crossing, interpolated
+            offer(float(value(probe.points(np.array([x])))[0]), x)
     return best
 
 
-@memoized(32)
-@one_blas_thread
+def turn_geometry(vehicle: Vehicle) -> tuple:
+    """Everything of ``vehicle`` the low-speed turn reads (docs/low_speed_turn.md): the names, the
+    couplings, the bodies, every axle's position, steering and track, each axle's share of its
+    unit's cornering stiffness (:func:`~lcvreport.model.low_speed.kinematics.stiffness_shares`)
+    and whether each unit is light enough to be a dolly -- not its masses, inertias, loads, roll
+    data or the stiffnesses' scale, so that variants that differ only in those share one turn (a
+    study's mass and cornering-stiffness factors).
+
+    Examples
+    --------
+    >>> from dataclasses import replace
+    >>> from lcvreport import load_preset
+    >>> v = load_preset("tractor_semitrailer")
+    >>> heavier = replace(v, units=tuple(replace(u, mass_kg=1.1 * u.mass_kg) for u in v.units))
+    >>> turn_geometry(heavier) == turn_geometry(v), heavier == v
+    (True, False)
+    """
+    from ..model.body import DOLLY_MASS_KG
+    from ..model.low_speed.kinematics import stiffness_shares
+    units = []
+    for k, u in enumerate(vehicle.units):
+        lateral = [a for a in u.axles if not (k == 0 and a.steered)]   # the axles the heading law weighs
+        shares = dict(zip((a.name for a in lateral),
+                          stiffness_shares([a.cornering_stiffness_axle_N_per_rad for a in lateral])))
+        units.append((u.name, u.mass_kg <= DOLLY_MASS_KG, u.front_coupling_m, u.rear_coupling_m, u.rear_end_m,
+                      u.body_front_m, u.body_rear_m, u.body_width_m,
+                      tuple((a.name, a.x_m, a.steered, a.track_width_m, shares.get(a.name)) for a in u.axles)))
+    return (vehicle.name, tuple(units))
+
+
+#: the turns computed, by :func:`turn_geometry` and the turn's arguments
+_TURNS = LRUCache(64)
+
+
 def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
                    rtol: float = 1e-10, atol: float = 1e-12) -> LowSpeedTurn:
     """The low-speed turn of ``vehicle`` and its measures (docs/low_speed_turn.md); computed
-    once per vehicle and turn (cached: the measures, the evidence and the turn with tire forces
-    read the same run).
+    once per geometry and turn (:func:`turn_geometry`: variants that differ in masses, loads or
+    roll data share it; the measures, the evidence and the turn with tire forces read the same
+    run) -- the same numbers bit for bit as a fresh computation, since the turn reads nothing else.
 
     Parameters
     ----------
@@ -357,6 +441,20 @@ def low_speed_turn(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: floa
     >>> bool(t.lssp_m < 10.0)                       # the exit straight never counts
     True
     """
+    try:
+        key = (turn_geometry(vehicle), type(radius_m), radius_m, type(angle_deg), angle_deg, rtol, atol)
+        hash(key)
+    except (TypeError, AttributeError):                 # not a vehicle, an unhashable argument: its refusal
+        return _low_speed_turn(vehicle, radius_m, angle_deg, rtol, atol)
+    t = _TURNS.get(key, lambda: _low_speed_turn(vehicle, radius_m, angle_deg, rtol, atol))
+    return t if t.vehicle is vehicle else replace(t, vehicle=vehicle)
+
+
+low_speed_turn.cache_clear = _TURNS.clear
+
+
+@one_blas_thread
+def _low_speed_turn(vehicle: Vehicle, radius_m: float, angle_deg: float, rtol: float, atol: float) -> LowSpeedTurn:
     from ..ranges import RANGES
     check_turn_geometry(vehicle)
     for key, value, name in (("turn_angle", angle_deg, "angle_deg"), ("turn_radius", radius_m, "radius_m")):
@@ -440,10 +538,8 @@ def turn_of_run(vehicle: Vehicle, run, radius_m: float, angle_deg: float) -> Low
                                           "max_tail_swing_m")}
         return LowSpeedTurn(vehicle, float(radius_m), float(angle_deg), None, None, {}, None, float(length), run,
                             {"steer_axle_radius_m": math.nan}, undefined)
-    found_out = [(r, p.name) for p in outer if (r := _extreme(p, radius, +1.0, s, centre, 0.0, angle))]
-    found_in = [(r, p.name) for p in inner if (r := _extreme(p, radius, -1.0, s, centre, 0.0, angle))]
-    best_out = max(((r[0], r[1], name) for r, name in found_out), key=lambda r: r[0], default=None)
-    best_in = min(((r[0], r[1], name) for r, name in found_in), key=lambda r: r[0], default=None)
+    best_out = _best_of([(p, p.name) for p in outer], radius, +1.0, s, centre, 0.0, angle)
+    best_in = _best_of([(p, p.name) for p in inner], radius, -1.0, s, centre, 0.0, angle)
     lssp = None if best_out is None or best_in is None else best_out[0] - best_in[0]
     if lssp is None:
         undefined["lssp_m"] = never.format(what="the vehicle's inner or outer edge", angle=angle_deg)

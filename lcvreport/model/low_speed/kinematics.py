@@ -58,9 +58,26 @@ class UnitGeometry:
     pull_x_m: float
     rear_coupling_x_m: float | None
     d_m: np.ndarray               # axle x from the pull point, the axles that carry lateral force
-    C_N_per_rad: np.ndarray       # tires x C_F of those axles
-    gain_per_m: float             # sum C d / sum C d^2 [1/m]
+    C_share: np.ndarray           # each one's share of their tires x C_F (stiffness_shares)
+    gain_per_m: float             # sum C d / sum C d^2 [1/m] (C: the shares)
     pull_y_m: float = 0.0         # the pull point's y (to the left) on the unit's frame
+
+
+def stiffness_shares(C) -> tuple[float, ...]:
+    """Each axle's share of its unit's cornering stiffness, C_j / sum C, rounded to 12 significant
+    digits: the heading law reads the stiffnesses only through these ratios, so a unit whose
+    stiffnesses are scaled together (a study's ``cornering_stiffness_scale``) makes the same turn
+    -- bit for bit, since the law is computed from the rounded shares themselves (12 digits: the
+    turn moves by ~1e-11 m against the unrounded ratios).
+
+    Examples
+    --------
+    >>> stiffness_shares([2.0e5, 1.0e5]) == stiffness_shares([2.2e5, 1.1e5])
+    True
+    """
+    C = np.asarray(C, dtype=float)
+    total = float(C.sum())
+    return tuple(float(f"{x:.12g}") for x in (C / total if total > 0 else C))
 
 
 def unit_geometry(vehicle: Vehicle, pull_offset_m: float = 0.0) -> list[UnitGeometry]:
@@ -88,7 +105,7 @@ def unit_geometry(vehicle: Vehicle, pull_offset_m: float = 0.0) -> list[UnitGeom
             pull = u.front_coupling_m
             axles = list(u.axles)
         d = np.array([a.x_m - pull for a in axles])
-        C = np.array([a.cornering_stiffness_axle_N_per_rad for a in axles])
+        C = np.array(stiffness_shares([a.cornering_stiffness_axle_N_per_rad for a in axles]))
         den = float(np.sum(C * d * d))
         if not den > 0:
             raise KinematicsError(f'unit {k + 1} "{u.name}": every axle is at its pull point; its heading is '
@@ -108,9 +125,25 @@ class KinematicRun:
     pieces: tuple                 # OdeSolution per path segment
     s_end: float
 
+    def _kept(self, name: str, s_arr: np.ndarray, compute):
+        """``compute(s_arr)``, kept for the last array of many points asked (the turn's measures
+        probe the same grid of s once per point of the vehicle; the array's bytes are the key)."""
+        if s_arr.size < 16:
+            return compute(s_arr)
+        memo = self.__dict__.setdefault("_memo", {})
+        key = s_arr.tobytes()
+        got = memo.get(name)
+        if got is None or got[0] != key:
+            got = memo[name] = (key, compute(s_arr))
+        return got[1]
+
     def headings(self, s) -> np.ndarray:
         """Headings [rad] of every unit at arc length ``s``: shape (N,) or (len(s), N)."""
         s_arr = np.atleast_1d(np.asarray(s, dtype=float))
+        out = self._kept("headings", s_arr, self._headings)
+        return out[0] if np.ndim(s) == 0 else out
+
+    def _headings(self, s_arr: np.ndarray) -> np.ndarray:
         out = np.empty((s_arr.size, len(self.geometry)))
         edges = [p[0] for p in self.pieces] + [self.s_end]
         for k, (lo, sol) in enumerate(self.pieces):
@@ -118,11 +151,15 @@ class KinematicRun:
             mask = (s_arr >= lo) & ((s_arr <= hi) if k == len(self.pieces) - 1 else (s_arr < hi))
             if mask.any():
                 out[mask] = sol(s_arr[mask]).T
-        return out[0] if np.ndim(s) == 0 else out
+        out.flags.writeable = False                 # kept: a caller must not change it
+        return out
 
     def pull_points(self, s) -> np.ndarray:
         """Pull points [m] of every unit: shape (len(s), N, 2)."""
         s_arr = np.atleast_1d(np.asarray(s, dtype=float))
+        return self._kept("pull_points", s_arr, self._pull_points)
+
+    def _pull_points(self, s_arr: np.ndarray) -> np.ndarray:
         psi = self.headings(s_arr).reshape(s_arr.size, -1)
         P = np.empty((s_arr.size, len(self.geometry), 2))
         P[:, 0] = self.path.point(s_arr)
@@ -132,6 +169,7 @@ class KinematicRun:
             c, sn = np.cos(psi[:, i - 1]), np.sin(psi[:, i - 1])
             P[:, i, 0] = P[:, i - 1, 0] + c * lx - sn * ly
             P[:, i, 1] = P[:, i - 1, 1] + sn * lx + c * ly
+        P.flags.writeable = False
         return P
 
     def unit_points(self, s, k: int, x_m, y_m) -> np.ndarray:
@@ -144,6 +182,40 @@ class KinematicRun:
         y = np.atleast_1d(np.asarray(y_m, dtype=float)) - self.geometry[k].pull_y_m
         c, sn = np.cos(psi)[:, None], np.sin(psi)[:, None]
         return np.stack([P[:, None, 0] + c * x - sn * y, P[:, None, 1] + sn * x + c * y], axis=-1)
+
+
+class DenseHeadings:
+    """A DOP853 run's dense output (scipy's :class:`~scipy.integrate.OdeSolution`) evaluated at
+    many points in one pass: every step's interpolant stacked, each point's step found by one
+    search -- the same segment and the same arithmetic as scipy's (bit for bit), without a Python
+    call per step (the low-speed turn's measures probe the run at thousands of points)."""
+
+    def __init__(self, sol):
+        from scipy.integrate._ivp.rk import Dop853DenseOutput
+        if not all(isinstance(i, Dop853DenseOutput) for i in sol.interpolants) or not sol.ascending:
+            raise TypeError("DenseHeadings stacks an ascending DOP853 OdeSolution")   # pragma: no cover
+        self.ts_sorted, self.side, self.n_segments = sol.ts_sorted, sol.side, sol.n_segments
+        self.t_old = np.array([i.t_old for i in sol.interpolants])
+        self.h = np.array([i.h for i in sol.interpolants])
+        self.y_old = np.array([i.y_old for i in sol.interpolants])
+        self.F = np.array([i.F for i in sol.interpolants])          # (segments, 7, n)
+
+    def __call__(self, t) -> np.ndarray:
+        """The states at ``t``: shape (n,) for a scalar, (n, len(t)) for an array (scipy's)."""
+        t_arr = np.atleast_1d(np.asarray(t, dtype=float))
+        seg = np.searchsorted(self.ts_sorted, t_arr, side=self.side) - 1
+        np.clip(seg, 0, self.n_segments - 1, out=seg)
+        x = ((t_arr - self.t_old[seg]) / self.h[seg])[:, None]
+        F = self.F[seg]
+        y = np.zeros((t_arr.size, self.y_old.shape[1]))
+        for i in range(F.shape[1]):
+            y += F[:, F.shape[1] - 1 - i]
+            if i % 2 == 0:
+                y *= x
+            else:
+                y *= 1 - x
+        y += self.y_old[seg]
+        return y[0] if np.ndim(t) == 0 else y.T
 
 
 def _rhs(geometry, path):
@@ -202,6 +274,6 @@ def integrate(vehicle: Vehicle, path, psi0, rtol: float = RTOL, atol: float = AT
         sol = solve_ivp(f, (lo, hi), y, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
         if not sol.success:            # pragma: no cover - DOP853 on a smooth, bounded field
             raise KinematicsError(f"the heading integration failed: {sol.message}")
-        pieces.append((lo, sol.sol))
+        pieces.append((lo, DenseHeadings(sol.sol)))
         y = sol.y[:, -1]
     return KinematicRun(vehicle, path, geometry, tuple(pieces), float(path.s_end))

@@ -1,0 +1,86 @@
+"""Benchmark: assessments at study speed (issue 43) -- one run times, on the B-double with the same
+factors (every trailer's mass and every unit's cornering stiffness varied), a plain study of 400
+cases (the template scheme's measures, batched where they have a batched form) and a scheme study
+of 40 cases (``lcv study --scheme``: every case assessed), per case; the scheme study with the
+template scheme as shipped and without its ``stfd`` entry (the nonlinear model's turn with tire
+forces); and ``assess`` of one new variant in process.  One process, one BLAS thread, the study's
+own chunk function (no Dask start-up in the times).
+
+    python benchmarks/scheme_study.py
+"""
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")    # before numpy is imported
+
+import time  # noqa: E402
+from dataclasses import replace  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from lcvreport.measures.assess import assess  # noqa: E402
+from lcvreport.measures.scheme import loads_scheme  # noqa: E402
+from lcvreport.model.vehicle_file import load_vehicle  # noqa: E402
+from lcvreport.study.compute import compute_chunk  # noqa: E402
+from lcvreport.study.spec import study_from_dict  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+VEHICLE = ROOT / "examples" / "vehicles" / "b_double.toml"
+TEMPLATE = (ROOT / "examples" / "schemes" / "template.toml").read_text(encoding="utf-8")
+NO_STFD = TEMPLATE[:TEMPLATE.index("[measures.stfd]")]
+FACTORS = {"lead_trailer.mass_scale": {"distribution": "uniform", "low": 0.7, "high": 1.1},
+           "rear_trailer.mass_scale": {"distribution": "uniform", "low": 0.7, "high": 1.1},
+           "prime_mover.cornering_stiffness_scale": {"distribution": "normal", "mean": 1.0, "sd": 0.08},
+           "rear_trailer.cornering_stiffness_scale": {"distribution": "normal", "mean": 1.0, "sd": 0.08}}
+
+
+def study(count: int, scheme: str | None):
+    keys = [m.key for m in loads_scheme(TEMPLATE).measures if m.key != "stfd"]
+    s = study_from_dict({"vehicle": str(VEHICLE), "measures": keys, "speed_kph": 88.0,
+                         "design": {"kind": "random", "count": count, "seed": 43}, "factors": FACTORS})
+    return s.with_scheme(scheme) if scheme else s
+
+
+def per_case(s, count: int) -> float:
+    t0 = time.perf_counter()
+    compute_chunk(s, np.arange(count))
+    return (time.perf_counter() - t0) / count
+
+
+def main() -> None:
+    v = load_vehicle(VEHICLE)
+    names = [u.name for u in v.units]
+    for f in list(FACTORS):
+        unit = f.split(".")[0]
+        if unit != "speed_kph" and unit not in names:
+            raise SystemExit(f"{f}: no unit {unit!r} in {names}")
+    plain = per_case(study(400, None), 400)
+    no_stfd = per_case(study(40, NO_STFD), 40)
+    shipped = per_case(study(10, TEMPLATE), 10)
+    print(f"plain study, 400 cases: {plain * 1e3:.1f} ms per case")
+    print(f"scheme study, 40 cases, template without stfd: {no_stfd * 1e3:.1f} ms per case, "
+          f"{no_stfd / plain:.1f}x the plain study (target <= 5x)")
+    print(f"scheme study, 10 cases, template as shipped (stfd: the nonlinear turn): {shipped * 1e3:.0f} ms per case, "
+          f"{shipped / plain:.0f}x")
+    print(f"10^4 cases of the template scheme on two cores, extrapolated: without stfd "
+          f"{1e4 * no_stfd / 2 / 60:.1f} min, as shipped {1e4 * shipped / 2 / 60:.0f} min (target <= 5 min)")
+    scheme = loads_scheme(NO_STFD)
+    assess(v, scheme)
+    times = []
+    for k in range(5):
+        w = replace(v, units=tuple(replace(u, mass_kg=u.mass_kg * (1.01 + 0.01 * k)) for u in v.units))
+        t0 = time.perf_counter()
+        assess(w, scheme)
+        times.append(time.perf_counter() - t0)
+    w = replace(v, units=tuple(replace(u, body_width_m=(u.body_width_m or 2.5) + 0.01) for u in v.units))
+    t0 = time.perf_counter()
+    assess(w, scheme)
+    geo = time.perf_counter() - t0
+    print(f"assess of a new mass variant (template without stfd): {min(times) * 1e3:.0f} ms; of a new geometry "
+          f"{geo * 1e3:.0f} ms (target <= 200 ms)")
+
+
+if __name__ == "__main__":
+    main()
