@@ -5,6 +5,7 @@
 #   ./build.sh setup    system packages (Debian) + .venv with pinned Python packages
 #   ./build.sh fmu      build/LCV.fmu, build/LCV3.fmu (pythonfmu, pythonfmu3) and build/LCVNative.fmu, build/LCVNative3.fmu (C)
 #   ./build.sh report   execute the notebooks, write build/report/{index.html,report.pdf,data/}
+#   ./build.sh docs     the documentation site into build/docs/ (Sphinx, warnings as errors)
 #   ./build.sh test     set up, build the FMUs, run the whole test suite
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -45,13 +46,19 @@ python_env() {
     stamp="$VENV/.installed-$(cat pyproject.toml constraints.txt | sha1sum | cut -c1-16)"
     if [ ! -f "$stamp" ]; then
         log "installing the package and pinned dependencies into .venv"
-        "$PY" -m pip install -q -c constraints.txt -e ".[fmu,report,study,test]"
+        "$PY" -m pip install -q -c constraints.txt -e ".[fmu,report,study,test,docs]"
         rm -f "$VENV"/.installed-*
         touch "$stamp"
     fi
 }
 
 setup() { system_packages; python_env; }
+
+docs() {
+    rm -rf build/docs
+    "$PY" -m sphinx -W --keep-going -q -b html -d build/docs/.doctrees docs build/docs
+    log "wrote build/docs/index.html"
+}
 
 fmu() {
     mkdir -p build
@@ -76,6 +83,7 @@ case "$cmd" in
     setup)  setup ;;
     fmu)    setup; fmu ;;
     report) setup; report ;;
+    docs)   setup; docs ;;
     test)   setup; fmu; run_tests "$@" ;;
-    *)      echo "usage: ./build.sh [all|setup|fmu|report|test]" >&2; exit 2 ;;
+    *)      echo "usage: ./build.sh [all|setup|fmu|report|docs|test]" >&2; exit 2 ;;
 esac

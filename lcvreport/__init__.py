@@ -7,6 +7,7 @@ thesis reproduced and audited, the standard yaw-plane measures, FMUs and reports
 
 Where things live (a folder is a layer; each imports only the ones above it)
 ---------------------------------------------------------------------------
+``_moved``               the module paths of 0.2.x that moved in 0.3.0, still importable (CHANGELOG.md)
 ``units``, ``ranges``    conversion factors and unit systems; the one table of valid
                          ranges of every parameter and input
 ``util/``                helpers with no physics:
@@ -163,9 +164,9 @@ from __future__ import annotations
 
 import importlib
 
-from . import ranges, units
+from . import _moved, ranges, units
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 #: public name -> module that defines it (loaded on first use: importing the package
 #: loads numpy only, so the FMU engine's embedded interpreter stays light)
@@ -185,13 +186,25 @@ _API = {
     "trim": "analysis.steady",
     "read_study": "study.results", "study_case": "study.results", "load_study": "study.spec",
     "run_study": "study.run",
+    # 0.3.0: a function for every command (docs/index.md#what-is-public); "module:name" where the
+    # public name is not the module's
+    "assess": "measures.assess", "load_scheme": "measures.scheme", "loads_scheme": "measures.scheme",
+    "roll": "measures.roll:roll_summary", "low_speed_turn": "measures.low_speed",
+    "turn_with_tire_forces": "measures.friction_demand", "tracking_stats": "tracking.statistics",
+    "place_tires": "tracking.placement", "build_fmus": "fmu.build:build_vehicle_fmus",
+    "build_report": "report.build:build_assessment", "build_model": "model.base", "respond": "analysis.respond",
+    "integrate": "analysis.integrate", "nonlinear_model": "model.nonlinear.model",
 }
 __all__ = sorted(_API) + ["ranges", "units"]
+
+if __name__ == "lcvreport":      # not the copy an FMU bundles under a name of its own: a host is left as it was
+    _moved.install()
 
 
 def __getattr__(name: str):
     if name in _API:
-        value = getattr(importlib.import_module(f".{_API[name]}", __name__), name)
+        module, _, attr = _API[name].partition(":")
+        value = getattr(importlib.import_module(f".{module}", __name__), attr or name)
         globals()[name] = value
         return value
     raise AttributeError(f"module 'lcvreport' has no attribute {name!r}")

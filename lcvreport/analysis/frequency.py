@@ -48,7 +48,31 @@ def steer_to_acceleration(vehicle: Vehicle, speed_mps: float, f_hz, tire_scale: 
 
 def rearward_amplification(vehicle: Vehicle, speed_mps: float, f_hz=RA_FREQUENCY_HZ, tire_scale: float = 1.0,
                            model: str = "yaw_plane"):
-    """``RA(f) = |G_N| / |G_1|`` [-] at one or many frequencies [Hz] on the model ``model``."""
+    """``RA(f) = |G_N| / |G_1|`` [-] at one or many frequencies [Hz] on the model ``model``.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    speed_mps : float
+        Forward speed [m/s].
+    f_hz : float or array_like
+        Steer frequency [Hz].
+    tire_scale : float
+        Factor on every tire coefficient [-].
+    model : str
+        A linear model (:data:`lcvreport.model.base.LINEAR_MODELS`).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``|G_N| / |G_1|`` [-] of the CGs' lateral accelerations, one per frequency.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> round(float(rearward_amplification(load_preset("aucnat"), 24.4444)), 2)
+    5.38
+    """
     G = np.abs(steer_to_acceleration(vehicle, speed_mps, f_hz, tire_scale, model))
     ra = G[..., -1] / G[..., 0]
     return float(ra) if np.ndim(ra) == 0 else ra

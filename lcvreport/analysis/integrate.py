@@ -115,6 +115,15 @@ def integrate(model, steer, speed_mps: float, t_end: float, dt: float, tire_scal
     IntegrationError
         A driven axle out of friction (naming the axle and the time), a lane change of the
         inverse system (linear models only: their exact response), a failed integration.
+
+    Examples
+    --------
+    >>> from lcvreport import build_model, load_vehicle
+    >>> from lcvreport.manoeuvres.steer import sine
+    >>> m = build_model(load_vehicle("examples/vehicles/b_double.toml"), "nonlinear")
+    >>> r = integrate(m, sine(0.01, 0.4), 24.4, 6.0, 0.05)
+    >>> float(r.time[-1]), 0.0 < r.peak_abs("fd_steer") < 0.2          # the steer tires' friction demand
+    (6.0, True)
     """
     from scipy.integrate import solve_ivp
     check_speed(speed_mps)

@@ -40,6 +40,13 @@ class Modes:
     speed_mps : float
         Forward speed [m/s].
     tire_scale : float
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset, modes
+    >>> m = modes(load_preset("aucnat"), 24.4)
+    >>> m.stable, m.eigenvalues.shape
+    (True, (12,))
     """
 
     eigenvalues: np.ndarray
@@ -159,6 +166,21 @@ def eigenvalues(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale: flo
                 model: str = "yaw_plane") -> np.ndarray:
     """Eigenvalues [1/s] of the model ``model`` in mode order; broadcasts over arrays of speed
     [m/s] and tire scale.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    speed_mps : float or array_like
+        Forward speed [m/s]; broadcasts.
+    tire_scale : float or array_like
+        Factor on every tire coefficient [-]; broadcasts.
+    model : str
+        A linear model (:data:`lcvreport.model.base.LINEAR_MODELS`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., n)
+        Complex eigenvalues [1/s], mode order (:func:`modes`).
 
     Examples
     --------

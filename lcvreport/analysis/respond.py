@@ -41,6 +41,14 @@ def respond(vehicle, model: str, steer, speed_mps: float, t_end: float, dt: floa
     Returns
     -------
     TimeResponse or SampledResponse
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> from lcvreport.manoeuvres.steer import sine
+    >>> r = respond(load_vehicle("examples/vehicles/b_double.toml"), "yaw_roll", sine(0.01, 0.4), 24.4, 6.0, 0.05)
+    >>> "phi3" in r.names
+    True
     """
     from ..model import linear
     if str(model).replace("-", "_") in linear.MODELS:         # a linear model (a registered one too)

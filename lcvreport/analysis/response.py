@@ -309,6 +309,20 @@ def step_response(vehicle: Vehicle, speed_mps: float, F: np.ndarray, t_end: floa
         Number of evenly spaced output points including t = 0.
     tire_scale : float
     label : str
+
+    Returns
+    -------
+    TimeResponse
+        The states and outputs at ``n_points`` times, SI.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lcvreport import load_preset
+    >>> F = np.zeros(12); F[0] = 1000.0
+    >>> r = step_response(load_preset("aucnat"), 24.4, F, t_end=5.0, n_points=51)
+    >>> r["y6"].shape
+    (51,)
     """
     RANGES["t_end"].check(t_end, "t_end")
     t = np.linspace(0.0, float(t_end), int(n_points))

@@ -98,6 +98,13 @@ def to_statespace(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0):
     control.StateSpace
         Inputs ``delta, P_<axle>..., T_<axle>...``; outputs the states, ``ay1..ayN``,
         ``y2..yN``; see the module docstring for units.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> sys = to_statespace(load_preset("tractor_semitrailer"), 24.4)
+    >>> sys.ninputs > 1, sys.input_labels[0]
+    (True, 'delta')
     """
     import control
     m = state_space(vehicle, speed_mps, tire_scale)

@@ -39,6 +39,15 @@ def steady_state(vehicle: Vehicle, speed_mps: float | np.ndarray, F: np.ndarray,
     -------
     numpy.ndarray, shape (..., n)
         The steady state (yaw plane: v1 [m/s], r [rad/s], theta [rad]).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lcvreport import load_preset
+    >>> v = load_preset("aucnat")
+    >>> F = np.zeros(12); F[0] = 1000.0                    # 1 kN lateral on the tractor
+    >>> steady_state(v, 24.4, F).shape
+    (12,)
     """
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
@@ -104,6 +113,30 @@ def trim(vehicle: Vehicle, speed_mps: float, F: np.ndarray, tire_scale: float = 
     """Trimmed straight running under a constant generalized force F (SI).
 
     Solves ``S x + b delta + F = 0`` with ``r1 = 0`` for ``x`` and ``delta``.
+    
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    speed_mps : float
+        Forward speed [m/s].
+    F : numpy.ndarray, shape (2N,)
+        Generalized force, SI (:func:`lcvreport.load_vector`).
+    tire_scale : float
+        Factor on every tire coefficient [-].
+
+    Returns
+    -------
+    Trim
+        The trim steer [rad], the states and the trimmed offtracking [m].
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset, load_vector, one_percent_rule
+    >>> v = load_preset("aucnat")
+    >>> t = trim(v, 24.4, load_vector(v, one_percent_rule(v, ["trailer2", "trailer3"])))
+    >>> abs(t.delta_rad) < 0.01
+    True
     """
     x, delta = steady_with_yaw_rate(vehicle, speed_mps, F, 0.0, tire_scale)
     (uq, xq), (up, xp) = reference_points(vehicle)

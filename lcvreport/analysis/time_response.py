@@ -125,6 +125,13 @@ class TimeResponse:
     steer : SteerInput or None
         The continuous steer input of a manoeuvre.
     label : str
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset, simulate
+    >>> from lcvreport.manoeuvres.steer import sine
+    >>> r = simulate(load_preset("aucnat"), 24.4, steer=sine(0.01, 0.4), t_end=5.0)  # doctest: +SKIP
+    >>> r["ay6"].shape  # doctest: +SKIP
     """
 
     vehicle: Vehicle

@@ -266,10 +266,23 @@ def build_vehicle_fmus(vehicle: Vehicle, out_dir: str | Path, kind: str = "both"
         kind of one vehicle sits in one folder and loads into one host (their model identifiers
         differ).  The nonlinear model's FMU is the Python FMI 2.0 one only.
 
+    Returns
+    -------
+    list of pathlib.Path
+        The FMUs written.
+
     Raises
     ------
     ValueError
         An unknown kind or FMI version; the nonlinear model with another kind or version.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from lcvreport import load_vehicle
+    >>> out = tempfile.mkdtemp()
+    >>> [p.name for p in build_vehicle_fmus(load_vehicle("examples/vehicles/b_double.toml"), out, kind="native")]
+    ['b_doubleNative.fmu']
     """
     if kind not in ("python", "native", "both"):
         raise ValueError(f"kind must be python, native or both, got {kind!r}")

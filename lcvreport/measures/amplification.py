@@ -99,6 +99,29 @@ def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_H
     (default the yaw plane; a model that is not linear integrated:
     :func:`lcvreport.analysis.respond.respond`, with its ``options``).
 
+    Parameters
+    ----------
+    vehicle : Vehicle
+    speed_mps : float
+        Forward speed [m/s].
+    f_hz : float
+        Steer frequency [Hz].
+    delta0_rad : float
+        Steer amplitude [rad].
+    tire_scale : float
+        Factor on every tire coefficient [-].
+    step_s, tail_s : float
+        Sampling step and the straight run after the sine [s].
+    model : str
+        Any model of :data:`lcvreport.model.base.MODELS`.
+    options : dict, optional
+        A nonlinear model's options (``tire``, ``friction_coefficient``, ``rtol``).
+
+    Returns
+    -------
+    SingleSine
+        The response's accelerations [m/s^2] and the rearward amplification [-].
+
     Examples
     --------
     >>> from lcvreport import load_preset

@@ -280,6 +280,13 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     Returns
     -------
     SchemeAssessment
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> a = assess(load_vehicle("examples/vehicles/b_double.toml"), "examples/schemes/template.toml")
+    >>> [m.key for m in a.measures][:2], a.scheme.name
+    (['srt_rrcu_g', 'yaw_damping_coefficient'], 'Template scheme (PLACEHOLDER limits, not a standard)')
     """
     from ..model.vehicle import check_vehicle
     from ..model.yaw_plane.loads import ResidualSources

@@ -325,6 +325,13 @@ def turn_with_tire_forces(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_de
         Missing geometry, a radius or angle out of range.
     IntegrationError
         A driven axle out of friction (the speed cannot be held), naming the axle and the time.
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> t = turn_with_tire_forces(load_vehicle("examples/vehicles/western_double.toml"))
+    >>> round(t.stfd, 3), t.path_error_max_m < 0.05
+    (0.212, True)
     """
     from ..ranges import RANGES
     RANGES["speed"].check(kph_to_mps(speed_kph), "turn speed", factor=3.6, unit="km/h")

@@ -231,6 +231,12 @@ def measure_set(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0, loa
         eigenvalues, and its friction demand (docs/model.md#the-model-object).  The families of a
         fixed model (the low-speed turn, the roll measures) are the same whatever ``model``.
 
+    Returns
+    -------
+    MeasureSet
+        Every key's value (None where undefined, with the reason in :meth:`MeasureSet.reason`);
+        ``to_dict()`` is ``lcv measures --json``.
+
     Examples
     --------
     >>> from lcvreport import load_preset

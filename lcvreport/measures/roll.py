@@ -101,7 +101,28 @@ class RollSummary:
 
 @one_blas_thread
 def roll_summary(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0) -> RollSummary:
-    """The roll summary of ``vehicle`` at ``speed_mps`` [m/s] (see :class:`RollSummary`).
+    """The roll summary of ``vehicle`` at ``speed_mps`` [m/s] (see :class:`RollSummary`): what
+    ``lcv roll`` prints (``lcvreport.roll``).
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        With its roll keys (docs/roll.md).
+    speed_mps : float
+        Forward speed [m/s] of the dynamic roll measures.
+    tire_scale : float
+        Factor on every tire coefficient [-].
+
+    Returns
+    -------
+    RollSummary
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> s = roll_summary(load_vehicle("examples/vehicles/b_double.toml"), 24.4)
+    >>> 0.3 < s.to_dict()["srt_min_g"] < 0.6
+    True
 
     Raises
     ------

@@ -113,10 +113,25 @@ class Scheme:
 def load_scheme(path: str | Path) -> Scheme:
     """Read and check a scheme file (see the module docstring).
 
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A scheme file (TOML, docs/assessment.md).
+
+    Returns
+    -------
+    Scheme
+
     Raises
     ------
     SchemeError
         Unreadable file or any key that is not as docs/assessment.md says, in one line naming it.
+
+    Examples
+    --------
+    >>> s = load_scheme("examples/schemes/template.toml")
+    >>> s.levels[0], "stfd" in [m.key for m in s.measures]
+    ('L1', True)
     """
     try:
         doc = read_toml_file(path, "scheme file")
@@ -137,7 +152,29 @@ def read_scheme_text(path: str | Path) -> str:
 
 
 def loads_scheme(text: str) -> Scheme:
-    """:func:`load_scheme` of a TOML text."""
+    """:func:`load_scheme` of a TOML text.
+
+    Parameters
+    ----------
+    text : str
+        The scheme file's text.
+
+    Returns
+    -------
+    Scheme
+
+    Raises
+    ------
+    SchemeError
+        Not TOML, or any key that is not as docs/assessment.md says, in one line naming it.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> s = loads_scheme(Path("examples/schemes/template.toml").read_text(encoding="utf-8"))
+    >>> s.name == load_scheme("examples/schemes/template.toml").name
+    True
+    """
     import tomllib
     try:
         doc = loads_toml(text)

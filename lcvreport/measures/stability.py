@@ -45,7 +45,30 @@ U_MIN_DEFAULT_MPS = 2.2352
 def least_damping(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
                   model: str = "yaw_plane") -> tuple[float | None, float | None]:
     """(least damping ratio [-], its damped frequency [Hz]) over the oscillatory modes of the
-    linear model ``model``; (None, None) if none."""
+    linear model ``model``; (None, None) if none.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    speed_mps : float
+        Forward speed [m/s].
+    tire_scale : float
+        Factor on every tire coefficient [-].
+    model : str
+        A linear model (:data:`lcvreport.model.base.LINEAR_MODELS`).
+
+    Returns
+    -------
+    tuple of (float or None, float or None)
+        The least damping ratio [-] and its damped frequency [Hz].
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> zeta, f_hz = least_damping(load_preset("aucnat"), 24.4)
+    >>> 0.0 < zeta < 1.0 and f_hz > 0.0
+    True
+    """
     lam = eigenvalues(vehicle, speed_mps, tire_scale, model)
     osc = lam[lam.imag > 1e-12 * max(np.abs(lam).max(), 1.0)]
     if osc.size == 0:
@@ -66,6 +89,23 @@ def critical_speed(vehicle: Vehicle, tire_scale: float = 1.0, u_min_mps: float =
     below the first unstable point, bisection to 0.01 km/h, rounded to 0.1 km/h.  An instability
     band narrower than the scan's steps can be missed: :func:`stability_crossings` computes every
     speed where an eigenvalue crosses the imaginary axis, exactly (the tests hold the two together).
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    tire_scale : float
+        Factor on every tire coefficient [-].
+    u_min_mps : float
+        Lowest speed looked at [m/s].
+    u_max_kph : float
+        Highest speed looked at [km/h].
+    model : str
+        A linear model (:data:`lcvreport.model.base.LINEAR_MODELS`).
+
+    Returns
+    -------
+    float or None
+        [km/h], to 0.1 km/h; None if stable up to ``u_max_kph``.
 
     Examples
     --------

@@ -94,10 +94,30 @@ def build_model(vehicle, name: str = "yaw_plane", **options) -> VehicleModel:
     """The model ``name`` (:data:`MODELS`) of ``vehicle``; ``options`` go to its builder (the
     nonlinear model's tire law and friction coefficient).
 
+    Parameters
+    ----------
+    vehicle : Vehicle
+    name : {"yaw_plane", "yaw_roll", "nonlinear"}
+        The command line's spelling (``yaw-plane``) too.
+    **options
+        The nonlinear model's ``tire`` ({"saturating", "linear"}) and ``friction_coefficient``.
+
+    Returns
+    -------
+    VehicleModel
+        A :class:`~lcvreport.model.linear.LinearModel` for the linear models.
+
     Raises
     ------
     ModelError
         An unknown model.
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> m = build_model(load_vehicle("examples/vehicles/b_double.toml"), "nonlinear", friction_coefficient=0.6)
+    >>> m.kind, m.state_names[:3]
+    ('nonlinear', ('X1', 'Y1', 'psi1'))
     """
     from .vehicle import check_vehicle
     check_vehicle(vehicle)

@@ -67,6 +67,12 @@ def load_preset(name: str, masses: str = "table") -> Vehicle:
     -------
     Vehicle
         SI.
+
+    Examples
+    --------
+    >>> v = load_preset("aucnat")
+    >>> v.n_units, v.unit_names[0]
+    (6, 'tractor')
     """
     check_preset(name)
     if masses not in MASS_OPTIONS:

@@ -73,6 +73,17 @@ class VehicleError(ValueError):
         The offending key (``mass_kg``, ``tires`` ...).
     where : str
         ``units[2] "dolly1" axles[0] "d1"`` or empty.
+
+    Examples
+    --------
+    >>> from dataclasses import replace
+    >>> from lcvreport import load_preset
+    >>> v = load_preset("aucnat")
+    >>> try:
+    ...     replace(v.units[0], mass_kg=-1.0)
+    ... except VehicleError as exc:
+    ...     exc.key
+    'mass_kg'
     """
 
     def __init__(self, key: str, message: str, where: str = ""):
@@ -142,6 +153,13 @@ class Axle:
         The axle drives (first unit only): the nonlinear model's driven axles share the
         longitudinal force that holds unit 1's speed (docs/nonlinear.md); None: the default, every
         non-steered axle of unit 1.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> a = load_preset("aucnat").units[0].axles[0]
+    >>> a.name, a.steered, a.tires
+    ('11', True, 2)
     """
 
     name: str
@@ -234,6 +252,13 @@ class Unit:
     rear_coupling_roll_stiffness_Nm_per_rad : float or None
         Roll stiffness of the rear coupling [N*m/rad]: 0 roll-free (a drawbar eye), > 0
         roll-coupled (a fifth wheel).
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> u = load_preset("aucnat").units[1]
+    >>> u.name, len(u.axles) > 0
+    ('trailer1', True)
     """
 
     name: str
@@ -339,6 +364,13 @@ class Vehicle:
         Front to back.
     description : str
         Free text (where the numbers come from).
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> v = load_vehicle("examples/vehicles/b_double.toml")
+    >>> v.name, v.unit_names
+    ('b_double', ('prime_mover', 'lead_trailer', 'rear_trailer'))
     """
 
     name: str

@@ -89,7 +89,21 @@ AXLE_KEYS = (("name", "x_m", "tires", "cornering_stiffness_N_per_rad", "aligning
 
 
 class VehicleFileError(VehicleError):
-    """A vehicle file that cannot be read or is invalid; the message names the place and key."""
+    """A vehicle file that cannot be read or is invalid; the message names the place and key.
+
+    Attributes
+    ----------
+    args : tuple
+        ``(message,)``: one line naming the file, the table and the key.
+
+    Examples
+    --------
+    >>> try:
+    ...     loads_vehicle("not toml [")
+    ... except VehicleFileError as exc:
+    ...     "TOML" in str(exc)
+    True
+    """
 
 
 def _keys(table: dict, spec: tuple, where: str) -> None:
@@ -184,7 +198,30 @@ def vehicle_from_dict(doc: dict, source: str = "") -> Vehicle:
 
 
 def loads_vehicle(text: str, source: str = "") -> Vehicle:
-    """Parse vehicle-file text (TOML); see :func:`vehicle_from_dict`."""
+    """Parse vehicle-file text (TOML); see :func:`vehicle_from_dict`.
+
+    Parameters
+    ----------
+    text : str
+        A vehicle file's text (docs/vehicle_files.md).
+    source : str
+        Where it came from, for messages.
+
+    Returns
+    -------
+    Vehicle
+
+    Raises
+    ------
+    VehicleFileError
+        Not TOML, or a key, value or unit that is not as docs/vehicle_files.md says (one line naming it).
+
+    Examples
+    --------
+    >>> from lcvreport import dumps_vehicle, load_preset
+    >>> loads_vehicle(dumps_vehicle(load_preset("aucnat"))).n_units
+    6
+    """
     if len(text) > MAX_FILE_BYTES:
         raise VehicleFileError("", f"the text is {len(text)} characters long; a vehicle file has at most "
                                    f"{MAX_FILE_BYTES} bytes")
@@ -276,6 +313,18 @@ def dumps_vehicle(vehicle: Vehicle, header: str = "", unit_comments: dict | None
         Comment lines put at the top (without ``#``).
     unit_comments, axle_comments : dict, optional
         Unit name / axle name -> comment lines written above that table.
+
+    Returns
+    -------
+    str
+        A ``lcv-vehicle/1`` file that :func:`loads_vehicle` reads back to an equal vehicle.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> v = load_preset("tractor_semitrailer")
+    >>> loads_vehicle(dumps_vehicle(v)) == v
+    True
     """
     unit_comments = unit_comments or {}
     axle_comments = axle_comments or {}

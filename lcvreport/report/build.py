@@ -150,6 +150,16 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
     -------
     dict
         ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
+
+    Examples
+    --------
+    A report takes a Jupyter kernel and about a minute (``lcv report`` runs this):
+
+    >>> from lcvreport import load_vehicle
+    >>> res = build_assessment(load_vehicle("examples/vehicles/b_double.toml"), "b_double_report",
+    ...                        pdf=False)  # doctest: +SKIP
+    >>> sorted(res)  # doctest: +SKIP
+    ['data', 'html', 'seconds']
     """
     from ..model.vehicle_file import dumps_vehicle
     version, progress = _start(paper, progress)

@@ -66,11 +66,26 @@ def read_study(folder, complete: bool = True):
     complete : bool
         Refuse a study with chunks still missing (default); False reads what is there.
 
+    Returns
+    -------
+    pandas.DataFrame
+        One row per case, sorted by ``case_id``.
+
     Raises
     ------
     StudyError
         A folder without results, a manifest that does not describe its study, missing
         chunks (when ``complete``), a damaged or foreign chunk.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from lcvreport import load_study, run_study
+    >>> out = tempfile.mkdtemp() + "/s"
+    >>> s = load_study("examples/studies/aucnat_loads.toml").with_count(8)  # doctest: +SKIP
+    >>> _ = run_study(s, out, progress=False)  # doctest: +SKIP
+    >>> len(read_study(out))  # doctest: +SKIP
+    8
     """
     import numpy as np
     import pandas as pd
@@ -117,5 +132,25 @@ def stored_study(folder):
 
 def study_case(folder, case_id: int):
     """``(vehicle, speed_mps, kwargs)`` of row ``case_id``: ``measure_set(vehicle, speed_mps,
-    **kwargs)`` recomputes that row alone."""
+    **kwargs)`` recomputes that row alone.
+
+    Parameters
+    ----------
+    folder : path
+        The ``--out`` folder of ``lcv study``.
+    case_id : int
+        The row's ``case_id``.
+
+    Returns
+    -------
+    tuple
+        ``(vehicle, speed_mps, kwargs)``: the case's Vehicle, its speed [m/s] and the keyword
+        arguments of :func:`~lcvreport.measures.measure_set.measure_set` (tire scale, loads, sources).
+
+    Examples
+    --------
+    >>> from lcvreport import measure_set
+    >>> vehicle, u, kw = study_case("aucnat_loads", 17)  # doctest: +SKIP
+    >>> measure_set(vehicle, u, **kw).hsso_m  # doctest: +SKIP
+    """
     return stored_study(folder).case(int(case_id))

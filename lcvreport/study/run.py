@@ -212,6 +212,18 @@ def run_study(study: Study, out, workers: int | None = None, scheduler: str | No
         The address of an existing Dask scheduler (``tcp://host:8786``).
     progress : bool, optional
         A progress bar on standard error (cases, cases/s, ETA); default: when it is a terminal.
+
+    Returns
+    -------
+    RunSummary
+        How many chunks were computed and found, the folder, the time.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from lcvreport import load_study
+    >>> s = load_study("examples/studies/aucnat_loads.toml")
+    >>> summary = run_study(s, tempfile.mkdtemp() + "/s", workers=2)  # doctest: +SKIP
     """
     out = Path(out)
     if workers is not None and scheduler is not None:

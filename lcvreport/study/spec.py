@@ -525,7 +525,28 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
 
 
 def load_study(path) -> Study:
-    """Read and check a study file (TOML)."""
+    """Read and check a study file (TOML).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A study file (TOML, docs/studies.md).
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    StudyError
+        Unreadable file or any key that is not as docs/studies.md says (one line naming it).
+
+    Examples
+    --------
+    >>> s = load_study("examples/studies/aucnat_loads.toml")
+    >>> s.n_cases, s.measures[0]
+    (10000, 'least_damping_ratio')
+    """
     from ..util.files import FileInputError, read_toml_file
     path = Path(path)
     try:

@@ -381,6 +381,16 @@ def place_tires(vehicle: Vehicle, speed_mps: float, tires: list[dict], positions
     TrackingError
         Tires and positions differ in number (the message says how many are needed),
         duplicate ids or positions, a plan the solver could not prove optimal.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> v = load_preset("tractor_semitrailer")
+    >>> slots = positions_of(v, None)
+    >>> tires = [{"id": f"t{k}", "conicity_N": 40.0 * (-1) ** k, "ply_steer_N": 10.0 * k} for k in range(len(slots))]
+    >>> p = place_tires(v, 24.4, tires)
+    >>> abs(p.offtracking_m) < 1e-3                    # [m]: the four tires nearly cancel
+    True
     """
     from scipy.optimize import Bounds, LinearConstraint, milp
     from scipy.sparse import coo_array

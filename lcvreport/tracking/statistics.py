@@ -145,6 +145,11 @@ def tracking_stats(vehicle: Vehicle, speed_mps: float, conicity: Distribution, p
     F_const : numpy.ndarray, optional
         A constant generalized force added (crossfall, misalignment: SI).
 
+    Returns
+    -------
+    TrackingStats
+        The exact mean and SD [m], the Monte Carlo quantiles and lane exceedance, the seed.
+
     Examples
     --------
     >>> from lcvreport import load_preset

@@ -414,6 +414,13 @@ def nonlinear_model(vehicle: Vehicle, tire: str = TIRE, friction_coefficient: fl
         An axle without ``static_load_N``; no driven axle.
     ValueError
         An unknown tire law, mu out of range.
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> m = nonlinear_model(load_vehicle("examples/vehicles/b_double.toml"), "saturating", 0.6)
+    >>> m.mu, m.n_states
+    (0.6, 9)
     """
     return NonlinearModel(vehicle, tire, float(friction_coefficient) if isinstance(friction_coefficient, (int, float))
                           and not isinstance(friction_coefficient, bool) else friction_coefficient)

@@ -272,6 +272,13 @@ def system_matrices(vehicle: Vehicle, speed_mps: float | np.ndarray, tire_scale:
     Returns
     -------
     M, S : numpy.ndarray, shape (..., 2N, 2N)
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> M, S = system_matrices(load_preset("aucnat"), 22.352)
+    >>> M.shape, S.shape
+    ((12, 12), (12, 12))
     """
     check_speed(speed_mps)
     check_tire_scale(tire_scale)

@@ -54,6 +54,12 @@ class ResidualLoads:
         Axle name -> residual lateral force along +y [N].
     T_Nm : dict
         Axle name -> residual aligning moment about +z [N*m].
+
+    Examples
+    --------
+    >>> r = ResidualLoads({"11": 100.0}, {"11": 30.0})
+    >>> r.P_N["11"], r.T_Nm["11"]
+    (100.0, 30.0)
     """
 
     P_N: dict = field(default_factory=dict)
@@ -136,6 +142,13 @@ def one_percent_rule(vehicle: Vehicle, units, t_sign: float = 1.0, fraction: flo
         An unknown or repeated unit.
     ValueError
         An axle of a listed unit without ``static_load_N``.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset
+    >>> r = one_percent_rule(load_preset("aucnat"), ["trailer3"])
+    >>> sorted(r.P_N) == [a.name for a in load_preset("aucnat").units[5].axles]
+    True
     """
     P, T = {}, {}
     for name in check_unit_names(vehicle, units):
@@ -166,6 +179,13 @@ def load_vector(vehicle: Vehicle, loads: ResidualLoads, convention: str = "consi
     -------
     numpy.ndarray, shape (2N,)
         Articulation rows 0.
+
+    Examples
+    --------
+    >>> from lcvreport import load_preset, one_percent_rule
+    >>> v = load_preset("aucnat")
+    >>> load_vector(v, one_percent_rule(v, ["trailer3"])).shape
+    (12,)
     """
     if convention not in CONVENTIONS:
         raise ValueError(f"convention must be one of {', '.join(CONVENTIONS)}, got {convention!r}")
