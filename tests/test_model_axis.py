@@ -179,3 +179,31 @@ def test_a_study_computes_the_friction_demand_case_by_case(tmp_path):
     vehicle, _u, _kw = study.case(0)                       # its loads by statics (issue 40)
     assert stfd[0] == pytest.approx(turn_with_tire_forces(vehicle).stfd, rel=1e-12)
     assert math.isfinite(float(cols["lssp_m"][0]))
+
+
+def test_the_registry_chooses_the_evidence_figure_and_a_new_measure_is_drawn_as_its_value(monkeypatch):
+    """Issue 41 item 5: a measure added to the lane change's family with no drawing named in the
+    registry is drawn as its value against the limits -- not as HSTO's path with the limit past
+    the final offset, nor as an RA band on the acceleration axis."""
+    from dataclasses import replace
+
+    from lcvreport.measures import registry
+    from lcvreport.measures.assess import assess
+    from lcvreport.measures.evidence import evidence
+    from lcvreport.measures.scheme import loads_scheme
+    v = load_vehicle(EXAMPLES / "b_double.toml")
+    a = assess(v, loads_scheme('scheme = "t"\nlevels = ["L1"]\n[measures.hsto_m]\nspeed_kph = 88.0\n'
+                               'source = "test"\nlevels = { L1 = { max = 0.6 } }\n'))
+    drawn = evidence(a, a.measures[0])
+    assert (drawn.kind, drawn.drawing) == ("lane_change", "offset")
+    new = replace(registry.MEASURES["hsto_m"], key="hsto_new_m", evidence="value", label="a new lane-change measure")
+    monkeypatch.setitem(registry.MEASURES, "hsto_new_m", new)
+    verdict = replace(a.measures[0], key="hsto_new_m")
+    ev = evidence(a, verdict)
+    assert (ev.kind, ev.drawing, ev.result) == ("value", "value", None)
+    fig = ev.plot()
+    texts = " ".join(t.get_text() for ax in fig.axes for t in ax.texts + [ax.title, ax.xaxis.label])
+    assert "final offset" not in texts and "RA" not in texts
+    fig_offset = drawn.plot()
+    assert any("final offset" in (line.get_label() or "") for ax in fig_offset.axes for line in ax.get_lines()) or \
+        any("final offset" in t.get_text() for ax in fig_offset.axes for t in ax.texts)

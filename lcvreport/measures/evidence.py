@@ -47,6 +47,12 @@ class Evidence:
     #: denominator), the reference points the measure was computed between
     ratio: tuple = ()
 
+    @property
+    def drawing(self) -> str:
+        """How it is drawn: the registry's ``evidence`` of the measure (measures.toml), ``value``
+        where it names none or where nothing was computed."""
+        return "value" if self.kind == "value" else MEASURES[self.verdict.key].evidence
+
     def plot(self):
         """The evidence with every level's limit drawn (a :class:`matplotlib.figure.Figure`)."""
         from ..plotting.assessment import fig_evidence
@@ -68,6 +74,8 @@ def evidence(assessment, verdict) -> Evidence:
     levels = assessment.scheme.levels
     if verdict.value is None and not (family == "yaw_damping" and verdict.lower_bound is not None):
         return Evidence("value", None, verdict, levels)       # (a heavily damped YDC: its decay is the evidence)
+    if MEASURES[key].evidence == "value":                     # the registry names no drawing: its value
+        return Evidence("value", None, verdict, levels)
     lane = (c.get("lane_change_ay_g", CONDITIONS["lane_change_ay_g"].default),
             c.get("lane_change_frequency_hz", CONDITIONS["lane_change_frequency_hz"].default))
     f_hz = c.get("ra_frequency_hz", CONDITIONS["ra_frequency_hz"].default)

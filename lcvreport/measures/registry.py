@@ -237,6 +237,9 @@ class Measure:
     #: what the toolkit's number leaves out of the standard's measure ("" for nothing): printed
     #: wherever it is judged (TASP: the steady part only)
     caveat: str = ""
+    #: how the assessment report draws its evidence (measures.toml's header): "value" where the
+    #: registry names no drawing
+    evidence: str = "value"
 
     @property
     def title(self) -> str:

@@ -51,9 +51,14 @@ def _beside(ax, handles=None) -> None:
 def fig_evidence(ev) -> Figure:
     """One measure's evidence with its limits (see the module docstring)."""
     key = ev.verdict.key
-    if ev.kind == "lane_change":
+    drawing = ev.drawing                          # the registry's (measures.toml "evidence")
+    if drawing == "value":
+        return _value(ev)
+    if drawing == "ratio" and ev.ratio:
+        return _ratio(ev, ev.result.response)
+    if ev.kind == "lane_change" and drawing in ("offset", "ltr"):
         return _lane_change(ev, key)
-    if ev.kind == "single_sine":
+    if ev.kind == "single_sine" and drawing == "ratio":
         return _single_sine(ev, key)
     if ev.kind == "pulse":
         from .time import fig_pulse
@@ -61,7 +66,7 @@ def fig_evidence(ev) -> Figure:
         fig = fig_pulse(ev.result, names, _title(ev))
         _text_box(fig.axes[0], ev)
         return fig
-    if ev.kind == "swept_path" and key in ("max_tail_swing_m", "frontal_swing_m"):
+    if ev.kind == "swept_path" and drawing == "swing":
         from .low_speed import fig_swing
         which = "tail" if key == "max_tail_swing_m" else "frontal"
         limits = [(levels, b) for levels, b, _kind in _limits(ev)]
@@ -106,7 +111,7 @@ def _lane_change(ev, key: str) -> Figure:
     from .roll import plot_ltr
     from .time import fig_lane_change
     lc = ev.result
-    if key == "rltr_lane_change":
+    if ev.drawing == "ltr":
         from ..model.linear import linear_model
         groups = len(linear_model(lc.response.vehicle, "yaw_roll").roll.groups)
         fig = plot_ltr(lc.response, groups, _title(ev))

@@ -210,6 +210,25 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
     BEGIN(fmi3GetFloat64, ANY_PHASE)
     if (!scalar_args(c, "fmi3GetFloat64", valueReferences, nValueReferences, values, nValues)) return fmi3Error;
     fmi3Status status = fmi3OK;
+    /* every value but the time in one call of the model (the outputs computed once, as FMI 2's
+       GetReal), in blocks of GET_BLOCK; a block the model refuses is asked again value by value,
+       so that each bad value reference is logged as before */
+    enum { GET_BLOCK = 512 };
+    unsigned vr[GET_BLOCK];
+    double got[GET_BLOCK];
+    size_t at[GET_BLOCK];
+    int refused = 0;
+    for (size_t start = 0; start < nValueReferences && !refused; start += GET_BLOCK) {
+        size_t end = start + GET_BLOCK < nValueReferences ? start + GET_BLOCK : nValueReferences, n = 0;
+        for (size_t i = start; i < end; ++i) {
+            if (valueReferences[i] == LCV_TIME_VR) { values[i] = c->m.s.time; continue; }
+            vr[n] = valueReferences[i];
+            at[n++] = i;
+        }
+        if (n && model_get_real(&c->m, vr, n, got) != 0) { refused = 1; break; }
+        for (size_t k = 0; k < n; ++k) values[at[k]] = got[k];
+    }
+    if (!refused) return status;
     for (size_t i = 0; i < nValueReferences; ++i) {
         fmi3ValueReference r = valueReferences[i];
         if (r == LCV_TIME_VR) { values[i] = c->m.s.time; continue; }
