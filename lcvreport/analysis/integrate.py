@@ -178,12 +178,7 @@ def integrate(model, steer, speed_mps: float, t_end: float, dt: float, tire_scal
         else:
             w = np.tile(w0, (cols.shape[1], 1))
             w[:, 0] = d
-            try:
-                out = model.derivatives(t, cols.T, w, u, tire_scale).T
-            except Exception as exc:                              # the model's refusal, with the time
-                if type(exc).__name__ == "TractionError":
-                    raise IntegrationError(f"at t = {t:.3f} s: {exc}") from None
-                raise
+            out = _derivatives(model, t, cols, w, u, tire_scale, f"at t = {t:.3f} s")
         return out if z.ndim == 2 else out[:, 0]
 
     z0 = np.zeros(n) if x0 is None else np.asarray(x0, dtype=float).copy()
@@ -221,6 +216,17 @@ def integrate(model, steer, speed_mps: float, t_end: float, dt: float, tire_scal
     r.evaluations = count[0]
     r.steer = steer
     return r
+
+
+def _derivatives(model, t, cols, w, u, tire_scale, when: str) -> np.ndarray:
+    """The model's derivatives of the states ``cols`` (columns); its refusal of a driven axle out of
+    friction as an :class:`IntegrationError` saying ``when``."""
+    try:
+        return model.derivatives(t, cols.T, w, u, tire_scale).T
+    except Exception as exc:                                      # the model's refusal, with the time
+        if type(exc).__name__ == "TractionError":
+            raise IntegrationError(f"{when}: {exc}") from None
+        raise
 
 
 class _Budget(Exception):
@@ -268,12 +274,7 @@ def integrate_step(model, x0, w, speed_mps: float, h: float, tire_scale: float =
         if count[0] > max_evaluations:
             raise _Budget(t)
         cols = z if z.ndim == 2 else z[:, None]
-        try:
-            out = model.derivatives(t, cols.T, w, u, tire_scale).T
-        except Exception as exc:                                  # the model's refusal, with the time
-            if type(exc).__name__ == "TractionError":
-                raise IntegrationError(f"at {t:.3f} s into the step: {exc}") from None
-            raise
+        out = _derivatives(model, t, cols, w, u, tire_scale, f"at {t:.3f} s into the step")
         return out if z.ndim == 2 else out[:, 0]
 
     try:

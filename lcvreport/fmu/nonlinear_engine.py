@@ -27,7 +27,7 @@ import numpy as np
 from ..analysis.integrate import IntegrationError, integrate_step
 from ..model.nonlinear.model import nonlinear_model
 from ..ranges import RANGES, RangeError
-from .engine import CosimError
+from .engine import CosimError, LCVEngine
 from .interface import Interface
 
 
@@ -196,32 +196,23 @@ class NonlinearEngine:
                              f"valid: {problem}")
         return out
 
-    def get_state(self) -> dict:
-        """JSON-serializable snapshot of everything that evolves (floats round-trip exactly)."""
-        return {"z": self.x.tolist(), "time": self.time, "clamped": self.clamped,
-                "last_speed_mps": self.last_speed_mps}
+    # the FMU state: the linear engine's snapshot (``z``, the time, the clamping, the last speed),
+    # over this engine's state vector
+    @property
+    def z(self) -> np.ndarray:
+        """The model's state (SI)."""
+        return self.x
 
-    def set_state(self, state: dict) -> None:
-        """Restore a snapshot of :meth:`get_state`.
+    @z.setter
+    def z(self, value) -> None:
+        self.x = np.array(value, dtype=float)
 
-        Raises
-        ------
-        CosimError
-            A snapshot of another size or with non-finite numbers.
-        """
-        try:
-            x = np.array(state["z"], dtype=float)
-            t = float(state["time"])
-            clamped = bool(state["clamped"])
-            last = float(state["last_speed_mps"])
-        except (KeyError, TypeError, ValueError):
-            raise CosimError("FMUstate", "the FMU state is not one this FMU wrote") from None
-        if x.shape != self.x.shape:
-            raise CosimError("FMUstate", f"the FMU state holds {x.size} values; {self.vehicle.name} needs {self.x.size}")
-        if not (np.all(np.isfinite(x)) and math.isfinite(t) and math.isfinite(last)):
-            raise CosimError("FMUstate", "the FMU state holds numbers that are not finite")
-        self.x, self.time, self.clamped, self.last_speed_mps = x, t, clamped, last
-        self.stepped_outputs = None
+    @property
+    def m(self) -> int:
+        return self.model.n_states
+
+    get_state = LCVEngine.get_state
+    set_state = LCVEngine.set_state
 
 
 __all__ = ["NonlinearEngine"]
