@@ -93,12 +93,21 @@ def _sections_owed(obj) -> list[str]:
     if inspect.isclass(obj):
         wanted = (("Attributes", "Parameters"), ("Examples",))
     else:
-        wanted = (("Parameters",), ("Returns",), ("Examples",))
+        wanted = (("Parameters",), ("Returns",), ("Examples",)) + ((("Raises",),) if _raises(obj) else ())
     return [alts[0] for alts in wanted if not any(f"\n{a}\n---" in doc for a in alts)]
 
 
+def _raises(function) -> bool:
+    """Whether ``function``'s own body has a ``raise`` statement (what it raises itself: numpydoc's
+    Raises section is owed)."""
+    import ast
+    import textwrap
+    return any(isinstance(node, ast.Raise) for node in ast.walk(ast.parse(textwrap.dedent(inspect.getsource(function)))))
+
+
 def test_every_public_name_has_a_numpydoc_docstring():
-    """Every function of ``__all__``: Parameters, Returns and an example; every class: its
+    """Every function of ``__all__``: Parameters, Returns, an example, and Raises where it raises
+    itself; every class: its
     Attributes (or Parameters) and an example.  The constant ``PRESETS`` and the modules
     ``ranges`` and ``units`` have their own module docstrings."""
     owed = {}

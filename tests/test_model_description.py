@@ -147,3 +147,10 @@ def test_the_interface_table_and_the_xml_agree(every_fmu):
             assert [int(sv[0].get("derivative")) for sv in ders] == [index[v.name] for v in itf.continuous_states]
         else:
             assert ders == [], name
+
+
+def test_the_fmus_carry_the_package_version(every_fmu):
+    """modelDescription.xml's version is the package's (0.2.0 was written into 0.3.0's FMUs)."""
+    import lcvreport
+    for name, path, _native in every_fmu:
+        assert _xml(path).get("version") == lcvreport.__version__, name

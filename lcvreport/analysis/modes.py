@@ -100,6 +100,29 @@ class Modes:
             return None
         return int(idx[np.argmin(self.damping_ratio[idx])])
 
+    def to_dict(self) -> dict:
+        """The modes as ``lcv eig --json`` prints them: eigenvalues as [real, imaginary] [1/s],
+        damping ratios [-], damped frequencies [Hz], the least damped mode (1-based; None if none
+        oscillates).
+
+        Returns
+        -------
+        dict
+            ``eigenvalues``, ``damping_ratio``, ``damped_frequency_hz``, ``least_damped_mode``.
+
+        Examples
+        --------
+        >>> from lcvreport import load_preset, modes
+        >>> d = modes(load_preset("aucnat"), 24.4).to_dict()
+        >>> len(d["eigenvalues"]), d["least_damped_mode"] is not None
+        (12, True)
+        """
+        k = self.least_damped
+        return {"eigenvalues": [[float(lam.real), float(lam.imag)] for lam in self.eigenvalues],
+                "damping_ratio": [float(z) for z in self.damping_ratio],
+                "damped_frequency_hz": [float(f) for f in self.damped_frequency_hz],
+                "least_damped_mode": None if k is None else k + 1}
+
     def dominant(self, state: str, among: tuple[str, ...] | None = None) -> int:
         """Index of the oscillatory mode (positive imaginary part) in which ``state``
         has the largest share of the magnitudes of the states ``among`` (all yaw

@@ -33,7 +33,8 @@ def respond(vehicle, model: str, steer, speed_mps: float, t_end: float, dt: floa
     F : numpy.ndarray, optional
         A linear model's generalized force of the residual sources (its exact response's).
     sources : ResidualSources, optional
-        The residual sources, for any other model.
+        The residual sources (on a linear model added to ``F``, their axle forces to its tire
+        force outputs).
     options : dict, optional
         The model's options (the nonlinear model's ``tire`` and ``friction_coefficient``) and
         the integration's ``rtol`` (default :data:`lcvreport.analysis.integrate.RTOL`).
@@ -53,7 +54,13 @@ def respond(vehicle, model: str, steer, speed_mps: float, t_end: float, dt: floa
     from ..model import linear
     if str(model).replace("-", "_") in linear.MODELS:         # a linear model (a registered one too)
         from .exact import response
-        return response(vehicle, speed_mps, steer, t_end, dt, F=F, tire_scale=tire_scale, model=model)
+        axle_force = None
+        if sources:                                             # lcv simulate's --residual/--misalignment/...
+            name = str(model).replace("-", "_")
+            F = sources.vector(vehicle, tire_scale, name) + (0.0 if F is None else F)
+            axle_force = sources.axle_forces(vehicle, tire_scale)
+        return response(vehicle, speed_mps, steer, t_end, dt, F=F, tire_scale=tire_scale, model=model,
+                        axle_force_N=axle_force)
     name = check_model(model)
     from .integrate import RTOL, integrate
     options = dict(options or {})

@@ -253,6 +253,11 @@ def simulate(vehicle: Vehicle, time: np.ndarray, speed_mps: float | np.ndarray, 
     TimeResponse
         Exact at every time point and between them for the held inputs.
 
+    Raises
+    ------
+    FloatingPointError
+        A response that overflows (an unstable vehicle over a long time span).
+
     Examples
     --------
     >>> import numpy as np
@@ -314,6 +319,11 @@ def step_response(vehicle: Vehicle, speed_mps: float, F: np.ndarray, t_end: floa
     -------
     TimeResponse
         The states and outputs at ``n_points`` times, SI.
+
+    Raises
+    ------
+    FloatingPointError
+        A response that overflows (an unstable vehicle over a long time span).
 
     Examples
     --------

@@ -195,9 +195,7 @@ def _cmd_study(args, out: _Out) -> int:
             raise UsageError(f"argument --report: {exc}") from None
         except ReportError as exc:
             raise OutputError(str(exc)) from None
-    doc = {"out": str(out_dir), "n_cases": summary.n_cases, "n_chunks": summary.n_chunks,
-           "chunks_computed": summary.n_computed, "chunks_found": summary.n_found, "seconds": summary.seconds,
-           "seed": study.seed}
+    doc = summary.to_dict()
     if report is not None:
         doc["report"] = {k: str(v) for k, v in report.items() if k != "seconds"}
     if args.json:

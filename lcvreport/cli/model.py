@@ -35,10 +35,7 @@ def _cmd_eig(args, out: _Out) -> int:
     _finite(m.eigenvalues)
     k = m.least_damped
     if args.json:
-        out.json({"eigenvalues": [[float(lam.real), float(lam.imag)] for lam in m.eigenvalues],
-                  "damping_ratio": [float(z) for z in m.damping_ratio],
-                  "damped_frequency_hz": [float(f) for f in m.damped_frequency_hz],
-                  "least_damped_mode": None if k is None else k + 1})
+        out.json(m.to_dict())
         return 0
     out.line(f"{v.name} at {_speed_text(args)}, tire scale {args.tire_scale:g} "
              f"({'stable' if m.stable else 'UNSTABLE'}); modes by real part, * = least damped")

@@ -21,6 +21,7 @@ from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial
                                  categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
                                  enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
+from .. import __version__
 
 #: the C sources of the native FMU listed in ``<SourceFiles>`` (``fmpy compile`` rebuilds it)
 NATIVE_SOURCE_FILES = names(NATIVE_SOURCES[2])
@@ -42,7 +43,7 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
     root = Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": model_identifier, "guid": guid(itf, model_identifier),
         "description": itf.description + ("" if not native else " Native C implementation: no Python at run time."),
-        "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": generation_tool,
+        "author": "lcvreport", "version": __version__, "license": "MIT", "generationTool": generation_tool,
         "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
     if native:                  # Model Exchange from the same model code (docs/fmu.md)
         me = SubElement(root, "ModelExchange", {

@@ -22,6 +22,7 @@ from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial
                                  categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
                                  enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
+from .. import __version__
 
 #: the C sources of the FMI 3.0 native FMU (built with LCV_FMI3 defined)
 FMI3_SOURCE_FILES = names(NATIVE_SOURCES[3])
@@ -41,7 +42,7 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
         "fmiVersion": "3.0", "modelName": model_identifier, "instantiationToken": guid(itf, model_identifier),
         "description": itf.description + (" Native C implementation: no Python at run time." if native else
                                           " Runs the lcvreport package in an embedded Python (pythonfmu3)."),
-        "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": generation_tool,
+        "author": "lcvreport", "version": __version__, "license": "MIT", "generationTool": generation_tool,
         "variableNamingConvention": "flat"})
     if native:
         SubElement(root, "ModelExchange", {

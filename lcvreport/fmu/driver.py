@@ -22,6 +22,7 @@ from .c_sources import _compile, c_files, fmi_header_dir, shipped_sources
 from .c_tree import DRIVER_HEADERS, DRIVER_INCLUDE_DIRS, DRIVER_SOURCES, names
 from .description_common import _num
 from .package import _zip, documentation_files
+from .. import __version__
 
 MODEL_IDENTIFIER = "PreviewDriver"
 SOURCES = names(DRIVER_SOURCES)
@@ -52,7 +53,7 @@ def driver_model_description(fmu_guid: str) -> bytes:
         "fmiVersion": "2.0", "modelName": MODEL_IDENTIFIER, "guid": fmu_guid,
         "description": "Path-following driver with preview: delta = K (Y_ref(t) - (Y1 + L psi1)), a half-cosine lane "
                        "change as the reference (lcvreport.manoeuvres.drivers.PreviewDriver).",
-        "author": "lcvreport", "version": "0.2.0", "license": "MIT", "generationTool": "lcvreport.fmu.driver (C99)",
+        "author": "lcvreport", "version": __version__, "license": "MIT", "generationTool": "lcvreport.fmu.driver (C99)",
         "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
     for tag, extra in (("ModelExchange", {"completedIntegratorStepNotNeeded": "true"}),
                        ("CoSimulation", {"canHandleVariableCommunicationStepSize": "true"})):

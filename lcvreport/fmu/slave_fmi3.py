@@ -13,6 +13,7 @@ from pythonfmu3.enums import Fmi3Status
 
 from .description_fmi3 import model_description3
 from .slave_core import SlaveCore
+from .. import __version__
 
 
 class LCV3(SlaveCore, Fmi3Slave):
@@ -29,7 +30,7 @@ class LCV3(SlaveCore, Fmi3Slave):
         Fmi3Slave.__init__(self, **kwargs)
         self._setup(self.resources)
         self.modelName = self.MODEL_IDENTIFIER
-        self.author, self.license, self.version = "lcvreport", "MIT", "0.2.0"
+        self.author, self.license, self.version = "lcvreport", "MIT", __version__
 
     def _error(self, text):
         self.log(text, Fmi3Status.error, "logStatusError")

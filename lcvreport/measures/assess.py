@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -268,9 +269,12 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
 
     Parameters
     ----------
-    vehicle : Vehicle
+    vehicle : Vehicle or path
+        The vehicle, or a vehicle file's path (read and checked: :func:`lcvreport.load_vehicle`).
     scheme : lcvreport.measures.scheme.Scheme or path
         The scheme, or a scheme file's path (read and checked: :func:`~lcvreport.measures.scheme.load_scheme`).
+        A file given by its path is named in the result with its SHA-256, as ``lcv assess``
+        names it (:meth:`SchemeAssessment.with_files`).
     tire_scale : float
     load_units : list of str, optional
         Units carrying the 1 % rule: a residual source of the trim and the straight path.
@@ -280,6 +284,15 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     Returns
     -------
     SchemeAssessment
+
+    Raises
+    ------
+    lcvreport.VehicleError, lcvreport.VehicleFileError, lcvreport.measures.scheme.SchemeError
+        A vehicle or scheme that is not valid (one line naming the key).
+    lcvreport.util.files.FileInputError
+        A file given by its path that is missing, not a regular file or too large.
+    ValueError
+        A crossfall among ``sources`` (it is the scheme's condition).
 
     Examples
     --------
@@ -291,10 +304,16 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     from ..model.vehicle import check_vehicle
     from ..model.yaw_plane.loads import ResidualSources
     from .measure_set import measure_values
+    files = {}
+    if isinstance(vehicle, str) or hasattr(vehicle, "__fspath__"):        # a vehicle file's path: read it
+        from ..model.vehicle_file import load_vehicle
+        from ..util.files import read_file_bytes
+        vehicle, files["vehicle"] = load_vehicle(vehicle), (Path(vehicle).name, read_file_bytes(vehicle, "vehicle file"))
     check_vehicle(vehicle)
-    if isinstance(scheme, (str, bytes)) or hasattr(scheme, "__fspath__"):   # a scheme file's path: read it
+    if isinstance(scheme, str) or hasattr(scheme, "__fspath__"):          # a scheme file's path: read it
+        from ..util.files import read_file_bytes
         from .scheme import load_scheme
-        scheme = load_scheme(scheme)
+        scheme, files["scheme"] = load_scheme(scheme), (Path(scheme).name, read_file_bytes(scheme, "scheme file"))
     if not isinstance(scheme, Scheme):
         raise TypeError(f"scheme must be a Scheme (lcvreport.measures.scheme.load_scheme(path)) or a scheme file's "
                         f"path, got the {type(scheme).__name__}")
@@ -341,8 +360,9 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     elif reached != scheme.levels[0]:
         first = scheme.levels[0]
         reason = "fails " + first + ": " + ", ".join(m.key for m in measures if m.verdicts[first] != "pass")
-    return SchemeAssessment(vehicle, scheme, measures, reached, reason, float(tire_scale),
-                            tuple(load_units) if load_units else (), sources)
+    a = SchemeAssessment(vehicle, scheme, measures, reached, reason, float(tire_scale),
+                         tuple(load_units) if load_units else (), sources)
+    return a.with_files(files.get("vehicle"), files.get("scheme")) if files else a
 
 
 def _verdict(m, doc: dict, levels) -> MeasureVerdict:

@@ -68,6 +68,13 @@ def load_preset(name: str, masses: str = "table") -> Vehicle:
     Vehicle
         SI.
 
+    Raises
+    ------
+    KeyError
+        A name that is not a preset (the valid names in the message).
+    ValueError
+        ``masses`` not one of :data:`MASS_OPTIONS`, or unrounded masses of a preset that has none.
+
     Examples
     --------
     >>> v = load_preset("aucnat")

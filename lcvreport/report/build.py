@@ -151,6 +151,13 @@ def build_assessment(vehicle, out_dir: str | Path, speed_mps: float | None = Non
     dict
         ``html``, ``pdf``, ``data`` paths (in ``out_dir``) and ``seconds``.
 
+    Raises
+    ------
+    lcvreport.report.notebooks.ReportError
+        A criteria file that is not valid, or a notebook that fails (one line naming it).
+    lcvreport.report.publish.OutputFolderError
+        An output folder that is not new, empty or an earlier report of this kind.
+
     Examples
     --------
     A report takes a Jupyter kernel and about a minute (``lcv report`` runs this):

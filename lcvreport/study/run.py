@@ -52,6 +52,26 @@ class RunSummary:
     n_cases: int
     seconds: float
     n_repaired: int = 0
+    seed: int | None = None
+
+    def to_dict(self) -> dict:
+        """The run as ``lcv study --json`` prints it (without ``--report``): the results folder,
+        cases, chunks computed now and found done, the wall time [s], the design's seed.
+
+        Returns
+        -------
+        dict
+            ``out``, ``n_cases``, ``n_chunks``, ``chunks_computed``, ``chunks_found``, ``seconds``,
+            ``seed``.
+
+        Examples
+        --------
+        >>> RunSummary(Path("out"), 2, 2, 0, 100, 1.5).to_dict()["chunks_computed"]
+        2
+        """
+        return {"out": str(self.out), "n_cases": self.n_cases, "n_chunks": self.n_chunks,
+                "chunks_computed": self.n_computed, "chunks_found": self.n_found, "seconds": self.seconds,
+                "seed": self.seed}
 
 
 def _chunk_job(study_doc: dict, k: int, start: int, stop: int, folder: str) -> int:
@@ -218,6 +238,12 @@ def run_study(study: Study, out, workers: int | None = None, scheduler: str | No
     RunSummary
         How many chunks were computed and found, the folder, the time.
 
+    Raises
+    ------
+    lcvreport.study.spec.StudyError
+        Both ``workers`` and ``scheduler``, ``workers`` outside [1, 256], an output folder that holds
+        other files than this study's, an unreachable scheduler (one line).
+
     Examples
     --------
     >>> import tempfile
@@ -274,7 +300,8 @@ def run_study(study: Study, out, workers: int | None = None, scheduler: str | No
                 stale.unlink()
             except OSError:
                 pass
-    return RunSummary(out, study.n_chunks, len(todo), found, n, time.perf_counter() - t0, len(repaired))
+    return RunSummary(out, study.n_chunks, len(todo), found, n, time.perf_counter() - t0, len(repaired),
+                      study.seed)
 
 
 #: the local cluster's workers: one BLAS thread; glibc's malloc told to keep freed memory

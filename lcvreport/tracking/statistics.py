@@ -150,6 +150,12 @@ def tracking_stats(vehicle: Vehicle, speed_mps: float, conicity: Distribution, p
     TrackingStats
         The exact mean and SD [m], the Monte Carlo quantiles and lane exceedance, the seed.
 
+    Raises
+    ------
+    lcvreport.tracking.tires.TrackingError
+        A ``mounting`` other than out, in or random, a lane not wider than the body, an axle that is
+        not the vehicle's, no tire position to draw.
+
     Examples
     --------
     >>> from lcvreport import load_preset

@@ -180,6 +180,11 @@ def load_vector(vehicle: Vehicle, loads: ResidualLoads, convention: str = "consi
     numpy.ndarray, shape (2N,)
         Articulation rows 0.
 
+    Raises
+    ------
+    ValueError
+        A ``convention`` that is not one of :data:`CONVENTIONS`.
+
     Examples
     --------
     >>> from lcvreport import load_preset, one_percent_rule
