@@ -8,6 +8,7 @@ thesis reproduced and audited, the standard yaw-plane measures, FMUs and reports
 Where things live (a folder is a layer; each imports only the ones above it)
 ---------------------------------------------------------------------------
 ``_moved``               the module paths of 0.2.x that moved in 0.3.0, still importable (CHANGELOG.md)
+``version``              the package's version (``__version__``)
 ``units``, ``ranges``    conversion factors and unit systems; the one table of valid
                          ranges of every parameter and input
 ``util/``                helpers with no physics:
@@ -165,8 +166,7 @@ from __future__ import annotations
 import importlib
 
 from . import _moved, ranges, units
-
-__version__ = "0.3.0"
+from .version import __version__
 
 #: public name -> module that defines it (loaded on first use: importing the package
 #: loads numpy only, so the FMU engine's embedded interpreter stays light)

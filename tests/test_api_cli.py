@@ -151,3 +151,19 @@ def test_folder_commands_call_their_function(command, module, name, tmp_path, mo
     assert len(calls) == 1 and "Called" in err.getvalue()
     assert isinstance(calls[0][0][0], lcvreport.Vehicle)
     assert np.isfinite(calls[0][0][0].units[0].mass_kg)
+
+
+def test_one_version_everywhere():
+    """pyproject.toml, ``lcvreport.__version__``, the installed metadata and ``lcv --version`` agree."""
+    import tomllib
+    from importlib.metadata import version
+
+    from conftest import ROOT
+    wanted = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    assert lcvreport.__version__ == wanted == version("lcvreport")
+    out = io.StringIO()
+    with pytest.raises(SystemExit):
+        import contextlib
+        with contextlib.redirect_stdout(out):
+            build_parser().parse_args(["--version"])
+    assert out.getvalue().split() == ["lcv", "(lcvreport)", wanted]

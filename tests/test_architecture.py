@@ -15,7 +15,7 @@ import lcvreport
 
 PACKAGE = Path(lcvreport.__file__).resolve().parent
 #: the layers, lowest first: a module may import its own folder and the ones before it
-LAYERS = ["_moved", "units", "ranges", "util", "model", "manoeuvres", "plotting", "analysis", "measures", "tracking", "thesis",
+LAYERS = ["_moved", "version", "units", "ranges", "util", "model", "manoeuvres", "plotting", "analysis", "measures", "tracking", "thesis",
           "fmu", "study", "report", "cli", "_entry"]
 #: imports of a higher layer allowed inside a function only (never at import time): none.  A
 #: result that plots itself imports ``plotting`` downward, inside its ``.plot()``.

@@ -21,7 +21,7 @@ from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial
                                  categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
                                  enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
-from .. import __version__
+from ..version import __version__
 
 #: the C sources of the native FMU listed in ``<SourceFiles>`` (``fmpy compile`` rebuilds it)
 NATIVE_SOURCE_FILES = names(NATIVE_SOURCES[2])

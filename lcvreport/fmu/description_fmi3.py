@@ -22,7 +22,7 @@ from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial
                                  categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
                                  enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
-from .. import __version__
+from ..version import __version__
 
 #: the C sources of the FMI 3.0 native FMU (built with LCV_FMI3 defined)
 FMI3_SOURCE_FILES = names(NATIVE_SOURCES[3])

@@ -22,7 +22,7 @@ from .c_sources import _compile, c_files, fmi_header_dir, shipped_sources
 from .c_tree import DRIVER_HEADERS, DRIVER_INCLUDE_DIRS, DRIVER_SOURCES, names
 from .description_common import _num
 from .package import _zip, documentation_files
-from .. import __version__
+from ..version import __version__
 
 MODEL_IDENTIFIER = "PreviewDriver"
 SOURCES = names(DRIVER_SOURCES)

@@ -11,7 +11,7 @@ from pythonfmu.enums import Fmi2Status
 
 from .description_fmi2 import model_description
 from .slave_core import SlaveCore
-from .. import __version__
+from ..version import __version__
 
 _CAUSALITY = {"parameter": Fmi2Causality.parameter, "input": Fmi2Causality.input, "output": Fmi2Causality.output}
 _VARIABILITY = {"fixed": Fmi2Variability.fixed, "continuous": Fmi2Variability.continuous}

@@ -13,7 +13,7 @@ from pythonfmu3.enums import Fmi3Status
 
 from .description_fmi3 import model_description3
 from .slave_core import SlaveCore
-from .. import __version__
+from ..version import __version__
 
 
 class LCV3(SlaveCore, Fmi3Slave):
