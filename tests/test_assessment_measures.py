@@ -15,7 +15,7 @@ from lcvreport import load_preset, load_vehicle
 from lcvreport.measures.amplification import single_sine
 from lcvreport.measures.measure_set import measure_set
 from lcvreport.measures.offtracking import straight_path
-from lcvreport.model.body import _rect, unit_poses
+from lcvreport.model.body import body_rectangle, unit_poses
 from lcvreport.model.yaw_plane.loads import ResidualSources
 
 from conftest import EXAMPLES
@@ -46,7 +46,7 @@ def _band_exact(v, tr, u):
     ys = []
     for k, (cg, psi) in enumerate(unit_poses(v, theta)):
         unit = v.units[k]
-        ys.extend(_rect(cg, psi, unit.body_front_m, unit.body_rear_m, unit.body_width_m / 2) @ normal)
+        ys.extend(body_rectangle(cg, psi, unit.body_front_m, unit.body_rear_m, unit.body_width_m / 2) @ normal)
     return max(ys) - min(ys)
 
 

@@ -111,7 +111,7 @@ def test_17_an_interruption_during_the_publish_waits_for_it(tmp_path, monkeypatc
         (folder / "index.html").write_text(text)
         (folder / "data" / "x.csv").write_text(text)
         publish.write_manifest(folder, "test")
-    before = publish._folder_state(out)
+    before = publish.folder_state(out)
     real_rmtree = shutil.rmtree
 
     def rmtree_interrupted(path, *a, **kw):
@@ -124,7 +124,7 @@ def test_17_an_interruption_during_the_publish_waits_for_it(tmp_path, monkeypatc
     monkeypatch.setattr(publish.shutil, "rmtree", rmtree_interrupted)
     try:
         with pytest.raises(KeyboardInterrupt):
-            publish._publish(staged, out, before)
+            publish.publish_staged(staged, out, before)
     finally:
         signal.signal(signal.SIGTERM, previous)
     assert (out / "index.html").read_text() == "new"

@@ -406,7 +406,7 @@ class VariantBatch:
         derivative located on its Hermite interpolant, valued by the quintic one (as
         :meth:`~lcvreport.analysis.exact.ManoeuvreResponse.extrema`).  Flat arrays (variant,
         signal, time [s], value) and the signals' values at the last sample (B, K)."""
-        from .extrema import _hermite_roots, _quintic
+        from .extrema import hermite_roots, quintic_hermite
         C1 = C @ Mz
         C2 = C1 @ Mz
         K = C.shape[1]
@@ -424,8 +424,8 @@ class VariantBatch:
         ya, yb = np.einsum("nd,nd->n", Za, c), np.einsum("nd,nd->n", Zb, c)
         sa, sb = np.einsum("nd,nd->n", Za, c2), np.einsum("nd,nd->n", Zb, c2)
         da, db = D1[b_i, k_i, s_i], D1[b_i, k1, s_i]
-        tau = _hermite_roots(da, sa, db, sb, dt)
-        val = _quintic(ya, da, sa, yb, db, sb, dt, tau)
+        tau = hermite_roots(da, sa, db, sb, dt)
+        val = quintic_hermite(ya, da, sa, yb, db, sb, dt, tau)
         return b_i, s_i, t0 + (k_i + tau) * dt, val, y_last
 
     def extremes(self, speed_mps: float, steer, t_end: float, dt: float, signals, tire_scale: float,

@@ -36,7 +36,7 @@ from ..manoeuvres.steer import SteerInput
 from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
 from .discretize import augmented_state_matrix
-from .extrema import _scan
+from .extrema import power_scan
 from .response import ManoeuvreError, OutputMap, steered_point
 from .time_response import Segment, TimeResponse, expm
 
@@ -193,7 +193,7 @@ def response(vehicle: Vehicle, speed_mps: float, steer: SteerInput, t_end: float
             ta = t_start + ka * dt
             za = z0 if abs(ta - piece.t0) <= 1e-12 * max(1.0, piece.t0) else expm(Mz * (ta - piece.t0)) @ z0
             Phi = expm(Mz * dt)
-            Z = _scan(Phi, za, count)
+            Z = power_scan(Phi, za, count)
             z_end = expm(Mz * (t1 - (t_start + kb * dt))) @ Z[-1] \
                 if math.isfinite(t1) and t1 <= t_end + 1e-12 else None
         else:

@@ -10,7 +10,7 @@ import numpy as np
 
 
 
-def _hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
+def hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
     """The roots in [0, 1] of cubic Hermite interpolants of f (values f0, f1 of opposite
     sign, slopes d0, d1 per unit time over a step h, one for all or one each), vectorized:
     Newton from the secant root, kept inside a bracket that shrinks with every iterate
@@ -50,7 +50,7 @@ def _hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
 
 
 def _hermite_root(f0: float, d0: float, f1: float, d1: float, h: float) -> float:
-    """:func:`_hermite_roots` of one interval, on Python floats: the same safeguarded Newton
+    """:func:`hermite_roots` of one interval, on Python floats: the same safeguarded Newton
     iteration, stopped when this interval's own iterate settles (the array version stops when
     all have; the roots agree to rounding)."""
     d0, d1 = d0 * h, d1 * h
@@ -80,7 +80,7 @@ def _hermite_root(f0: float, d0: float, f1: float, d1: float, h: float) -> float
     return tau
 
 
-def _quintic(y0, d0, s0, y1, d1, s1, h, tau) -> float:
+def quintic_hermite(y0, d0, s0, y1, d1, s1, h, tau) -> float:
     """Quintic Hermite interpolation of y at ``tau`` in [0, 1] from values, first and
     second derivatives (per unit time) at both ends of a step h."""
     d0, d1, s0, s1 = d0 * h, d1 * h, s0 * h * h, s1 * h * h
@@ -94,7 +94,7 @@ def _quintic(y0, d0, s0, y1, d1, s1, h, tau) -> float:
     return h00 * y0 + h10 * d0 + h20 * s0 + h01 * y1 + h11 * d1 + h21 * s1
 
 
-def _scan(Phi: np.ndarray, z0: np.ndarray, count: int) -> np.ndarray:
+def power_scan(Phi: np.ndarray, z0: np.ndarray, count: int) -> np.ndarray:
     """``Z[k] = Phi^k z0`` for k < count by doubling (log2 count products)."""
     Z = np.empty((count, z0.size))
     Z[0] = z0

@@ -19,7 +19,7 @@ from ..ranges import RANGES
 RA_FREQUENCY_HZ = 0.4
 
 
-def _freq(f_hz):
+def checked_frequency(f_hz):
     f = np.asarray(f_hz, dtype=float)
     RANGES["frequency"].check(float(f.min()) if f.size else 0.0, "frequency")
     RANGES["frequency"].check(float(f.max()) if f.size else 0.0, "frequency")
@@ -37,7 +37,7 @@ def steer_to_acceleration(vehicle: Vehicle, speed_mps: float, f_hz, tire_scale: 
     """
     check_speed(speed_mps)
     check_tire_scale(tire_scale)
-    f = _freq(f_hz)
+    f = checked_frequency(f_hz)
     co = linear_model(vehicle, model)
     M, S, b = co.M(speed_mps), co.S(speed_mps, tire_scale), co.B_delta(tire_scale)
     V, R = co.velocity_map(speed_mps), co.yaw_rate_map()

@@ -36,7 +36,7 @@ from ..model.yaw_plane.outputs import rear_end_weights
 from ..util.numerics import expm as _expm_checked
 from ..util.threads import one_blas_thread
 from .discretize import GLOBAL_STATES
-from .extrema import _hermite_roots, _quintic
+from .extrema import hermite_roots, quintic_hermite
 
 #: the unit of every signal by the start of its name (first match): (prefix, column suffix, unit)
 SIGNAL_UNITS = (("delta", "rad", "rad"), ("theta", "rad", "rad"), ("psi", "rad", "rad"), ("phi", "rad", "rad"),
@@ -317,9 +317,9 @@ class TimeResponse:
                     rows = np.arange(k.size)
                     ya, sa, yb, sb = Ya[rows, sig], Ya[rows, K + sig], Yb[rows, sig], Yb[rows, K + sig]
                     da, db = D1[sig, k], D1[sig, k1]
-                    tau = _hermite_roots(da, sa, db, sb, h[k])
+                    tau = hermite_roots(da, sa, db, sb, h[k])
                     tk = t[k] + tau * h[k]
-                    val = _quintic(ya, da, sa, yb, db, sb, h[k], tau)
+                    val = quintic_hermite(ya, da, sa, yb, db, sb, h[k], tau)
                     keep = (tk >= t_from) & (tk <= t_to)
                     sig, tk, val = sig[keep], tk[keep], val[keep]
                     bounds = np.searchsorted(sig, np.arange(K + 1))

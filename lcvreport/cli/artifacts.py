@@ -8,8 +8,8 @@ from pathlib import Path
 
 
 from ..ranges import RangeError
-from .options import UsageError, _load_units, _sources, _speed_mps, _vehicle
-from .output import OutputError, _Out
+from .options import UsageError, load_units_of, sources_of, speed_mps_of, vehicle_of
+from .output import OutputError, Output
 
 
 def run_report(command: str, build, wrote) -> None:
@@ -31,7 +31,7 @@ def run_report(command: str, build, wrote) -> None:
     print(f"{command}: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
 
 
-def _cmd_fmu(args, out: _Out) -> int:
+def cmd_fmu(args, out: Output) -> int:
     from ..fmu.build import build_vehicle_fmus
     from ..fmu.c_sources import FmuBuildError
     from ..model.base import check_model
@@ -50,18 +50,18 @@ def _cmd_fmu(args, out: _Out) -> int:
                              f"--fmi 2), got --kind {args.kind or 'both'} --fmi {args.fmi}; no FMU was built")
         from ..model.nonlinear.model import nonlinear_model
         from ..model.vehicle import VehicleError
-        v = _vehicle(args)
+        v = vehicle_of(args)
         try:
             nonlinear_model(v)                  # every axle's static_load_N: one line naming the axle
         except VehicleError as exc:
             raise UsageError(f"argument --model nonlinear: {v.name}: {exc}; no FMU was built") from None
         args.kind = "python"
     else:
-        v = _vehicle(args)
+        v = vehicle_of(args)
     try:
         kw = {"model": model}
         if args.speed_kph is not None or args.speed_mph is not None:
-            kw["u_start_mps"] = _speed_mps(args)      # the start value of the input u
+            kw["u_start_mps"] = speed_mps_of(args)      # the start value of the input u
         kind = args.kind or "both"
         paths = build_vehicle_fmus(v, args.out, kind=kind, fmi=int(args.fmi), **kw)
     except FmuBuildError as exc:
@@ -71,23 +71,23 @@ def _cmd_fmu(args, out: _Out) -> int:
     return 0
 
 
-def _cmd_report(args, out: _Out) -> int:
+def cmd_report(args, out: Output) -> int:
     from ..report.build import build_assessment
     from ..report.publish import OutputFolderError, check_output_folder
     try:
         check_output_folder(args.out)          # before anything is computed
     except OutputFolderError as exc:
         raise UsageError(f"argument {exc}") from None
-    v = _vehicle(args)
-    speed = _speed_mps(args) if (args.speed_kph is not None or args.speed_mph is not None) else None
-    units = _load_units(args, v) if args.load is not None else None
+    v = vehicle_of(args)
+    speed = speed_mps_of(args) if (args.speed_kph is not None or args.speed_mph is not None) else None
+    units = load_units_of(args, v) if args.load is not None else None
     if units:
         from ..model.yaw_plane.loads import one_percent_rule
         try:
             one_percent_rule(v, units)
         except ValueError as exc:
             raise UsageError(f"argument --load: {exc}") from None
-    src = _sources(args, v)
+    src = sources_of(args, v)
     try:
         src.vector(v)
     except (KeyError, RangeError) as exc:
@@ -103,7 +103,7 @@ def _cmd_report(args, out: _Out) -> int:
     tracking = {"tires": None, "stats": None}
     if args.tires:
         from ..tracking.tires import read_mounted_tires
-        tracking["tires"] = read_mounted_tires(args.tires)      # checked by _sources above
+        tracking["tires"] = read_mounted_tires(args.tires)      # checked by sources_of above
         if not v.steered_axles:
             raise UsageError(f"argument --tires: {v.name} has no steered axle: the trim needs one")
     if args.tracking_stats is not None:
@@ -127,7 +127,7 @@ def _cmd_report(args, out: _Out) -> int:
     return 0
 
 
-def _cmd_study(args, out: _Out) -> int:
+def cmd_study(args, out: Output) -> int:
     from ..study.run import run_study
     from ..study.spec import StudyError, load_study
     try:

@@ -2,8 +2,8 @@
 verdict table, the level each measure reaches and the vehicle's (docs/assessment.md)."""
 from __future__ import annotations
 
-from .options import UsageError, _line, _load_units, _sources, _vehicle
-from .output import _Out
+from .options import UsageError, one_line, load_units_of, sources_of, vehicle_of
+from .output import Output
 
 
 def load_scheme_option(path: str):
@@ -31,17 +31,17 @@ def assessment_of(args):
 
     from ..measures.assess import assess
     from ..model.presets import preset_path
-    v = _vehicle(args)
+    v = vehicle_of(args)
     scheme = load_scheme_option(args.scheme)
-    units = _load_units(args, v) if args.load is not None else None
-    sources = _sources(args, v)
+    units = load_units_of(args, v) if args.load is not None else None
+    sources = sources_of(args, v)
     a = assess(v, scheme, args.tire_scale, units, sources if sources else None)
     vehicle = (Path(args.vehicle).name, _file_bytes(args.vehicle, "vehicle file")) if args.vehicle is not None \
         else (f"preset {args.preset}", preset_path(args.preset).read_bytes())
     return v, scheme, a.with_files(vehicle, (Path(args.scheme).name, _file_bytes(args.scheme, "scheme file")))
 
 
-def _cmd_assess(args, out: _Out) -> int:
+def cmd_assess(args, out: Output) -> int:
     if args.out is not None:
         from ..report.publish import OutputFolderError, check_output_folder
         try:
@@ -89,7 +89,7 @@ def verdict_lines(a) -> list[str]:
     s = a.scheme
     status = {"template": " -- a TEMPLATE: its numbers are placeholders, not a standard",
               "draft": " -- a DRAFT"}.get(s.status, "")
-    lines = [f"{a.vehicle.name} assessed against {_line(s.name)}{status}",
+    lines = [f"{a.vehicle.name} assessed against {one_line(s.name)}{status}",
              f"  levels, most demanding first: {', '.join(s.levels)}; tire scale {a.tire_scale:g}"]
     width = max(8, *(len(level) for level in s.levels))
     vw = max(10, *(len(m.value_text()) for m in a.measures))
@@ -100,11 +100,11 @@ def verdict_lines(a) -> list[str]:
         lines.append(row + "".join(f" {VERDICT_WORDS[m.verdicts[level]]:>{width}}" for level in s.levels)
                      + f"  {m.level_reached or 'none'}")
     lines.append(f"  level reached by the vehicle: {a.level_reached or 'none'}"
-                 + (f" ({_line(a.reason)})" if a.reason else ""))
+                 + (f" ({one_line(a.reason)})" if a.reason else ""))
     from ..measures.registry import MEASURES
     for m in a.measures:
         if m.reason:
-            lines.append(f"  {m.key}: {_line(m.reason)}")
+            lines.append(f"  {m.key}: {one_line(m.reason)}")
     for m in a.measures:
         if MEASURES[m.key].caveat:
             lines.append(f"  {m.key}: {MEASURES[m.key].caveat}")

@@ -35,16 +35,16 @@ from typing import Sequence
 
 from ..ranges import RangeError
 from ..units import MPS_PER_KPH, MPS_PER_MPH
-from .artifacts import _cmd_fmu, _cmd_report, _cmd_study
-from .assess import _cmd_assess
-from .measures import _cmd_measures
-from .model import _cmd_eig, _cmd_matrices, _cmd_presets, _cmd_steady
-from .options import UsageError, _help_range, _line, _ranged
-from .output import OutputError, _Out
-from .roll import _cmd_roll
-from .simulate import _cmd_simulate
-from .tracking import _cmd_tracking
-from .turn import _cmd_turn
+from .artifacts import cmd_fmu, cmd_report, cmd_study
+from .assess import cmd_assess
+from .measures import cmd_measures
+from .model import cmd_eig, cmd_matrices, cmd_presets, cmd_steady
+from .options import UsageError, help_range, one_line, ranged
+from .output import OutputError, Output
+from .roll import cmd_roll
+from .simulate import cmd_simulate
+from .tracking import cmd_tracking
+from .turn import cmd_turn
 
 
 #: exit status of a closed pipe (128 + SIGPIPE), as a shell reports a tool SIGPIPE ended
@@ -81,15 +81,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     def speed(sp: argparse.ArgumentParser, required: bool = True) -> None:
         g = sp.add_mutually_exclusive_group(required=required)
-        g.add_argument("--speed-kph", type=_ranged("speed", 1 / MPS_PER_KPH, "km/h", "forward speed in km/h"),
-                       metavar="V", help=f"forward speed [km/h], in {_help_range('speed', 1 / MPS_PER_KPH, 'km/h')}")
-        g.add_argument("--speed-mph", type=_ranged("speed", 1 / MPS_PER_MPH, "mph", "forward speed in mph"),
-                       metavar="V", help=f"forward speed [mph], in {_help_range('speed', 1 / MPS_PER_MPH, 'mph')}")
+        g.add_argument("--speed-kph", type=ranged("speed", 1 / MPS_PER_KPH, "km/h", "forward speed in km/h"),
+                       metavar="V", help=f"forward speed [km/h], in {help_range('speed', 1 / MPS_PER_KPH, 'km/h')}")
+        g.add_argument("--speed-mph", type=ranged("speed", 1 / MPS_PER_MPH, "mph", "forward speed in mph"),
+                       metavar="V", help=f"forward speed [mph], in {help_range('speed', 1 / MPS_PER_MPH, 'mph')}")
 
     def tires(sp: argparse.ArgumentParser) -> None:
-        sp.add_argument("--tire-scale", default=1.0, type=_ranged("tire_scale", what="factor on the tire "
+        sp.add_argument("--tire-scale", default=1.0, type=ranged("tire_scale", what="factor on the tire "
                         "coefficients"), metavar="S",
-                        help=f"factor on every tire coefficient (chapter V), in {_help_range('tire_scale')}; "
+                        help=f"factor on every tire coefficient (chapter V), in {help_range('tire_scale')}; "
                              "default 1")
 
     def load(sp: argparse.ArgumentParser, required: bool, convention: bool = True) -> None:
@@ -122,9 +122,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="residual force P [N] (+y) and moment T [N*m] (+z) on an axle; repeatable")
         sp.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
                         help=f"thrust angle of an axle [rad], nose-right positive, in "
-                             f"{_help_range('misalignment')}; repeatable or comma-separated")
-        sp.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
-                        help=f"road crossfall [%%], positive falling toward +y, in {_help_range('crossfall')}")
+                             f"{help_range('misalignment')}; repeatable or comma-separated")
+        sp.add_argument("--crossfall-percent", type=ranged("crossfall", what="road crossfall in %"), metavar="C",
+                        help=f"road crossfall [%%], positive falling toward +y, in {help_range('crossfall')}")
         sp.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML: position, conicity_N, "
                                                          "ply_steer_N, serial_side[, moments]): their axle P and T")
 
@@ -137,9 +137,9 @@ def build_parser() -> argparse.ArgumentParser:
                 sp.add_argument(c.option, dest=c.key, choices=c.choices,
                                 help=c.definition.replace("%", "%%") + (f"; default {c.default}" if c.default else ""))
                 continue
-            sp.add_argument(c.option, dest=c.key, type=_ranged(c.range, unit=c.unit, what=c.label), metavar="X",
+            sp.add_argument(c.option, dest=c.key, type=ranged(c.range, unit=c.unit, what=c.label), metavar="X",
                             help=c.definition.replace("%", "%%") + f" [{c.unit}], in "
-                                 f"{_help_range(c.range, unit=c.unit)}; default {c.default:g}")
+                                 f"{help_range(c.range, unit=c.unit)}; default {c.default:g}")
 
     sim = sub.add_parser("simulate", help="exact response from rest to a steer input and residual sources, "
                                           "streamed as CSV (or JSON), SI units")
@@ -149,17 +149,17 @@ def build_parser() -> argparse.ArgumentParser:
                      help="steer input: step:A, sine:A:F, pulse:A:D, csv:FILE, lane-change:A0:F (A0 in m/s^2 or "
                           "with g, e.g. 0.15g), driver:A0:F[:K:T] (that path driven in closed loop by a preview "
                           "driver, gain K rad/m, preview T s); default none")
-    sim.add_argument("--t-end", default=10.0, type=_ranged("t_end", what="end time in s"), metavar="T",
-                     help=f"end time [s], in {_help_range('t_end')}; default 10")
+    sim.add_argument("--t-end", default=10.0, type=ranged("t_end", what="end time in s"), metavar="T",
+                     help=f"end time [s], in {help_range('t_end')}; default 10")
     sim.add_argument("--tire", choices=("saturating", "linear"), default=None,
                      help="the nonlinear model's tire law (default saturating: the brush tire)")
-    sim.add_argument("--friction-coefficient", type=_ranged("friction", what="friction coefficient mu"),
+    sim.add_argument("--friction-coefficient", type=ranged("friction", what="friction coefficient mu"),
                      metavar="MU", default=None, help="the nonlinear model's mu, in (0, 2]; default 0.8")
     sim.add_argument("--model", default="yaw-plane", choices=("yaw-plane", "yaw-roll", "nonlinear"),
                      help="the linear model: yaw-plane (default) or yaw-roll (adds roll rates, roll angles, sprung "
                           "CG accelerations, axle load transfers and load transfer ratios; needs the roll keys)")
-    sim.add_argument("--dt", default=0.01, type=_ranged("output_step", what="output step in s"), metavar="H",
-                     help=f"output step [s], in {_help_range('output_step')}; must divide t-end; default 0.01")
+    sim.add_argument("--dt", default=0.01, type=ranged("output_step", what="output step in s"), metavar="H",
+                     help=f"output step [s], in {help_range('output_step')}; must divide t-end; default 0.01")
     mea = sub.add_parser("measures", help="the measures: damping, RA, YDC, HSTO, HSSO, trim, the low-speed turn, "
                                           "roll (SRT, LTR, roll gains; with roll data) (defined in docs/measures.md)")
     source(mea)
@@ -223,8 +223,8 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--body-width-m", type=float, default=2.59, metavar="B", help="body width [m] (2.59)")
     st.add_argument("--draws", type=int, default=1_000_000, metavar="N", help="Monte Carlo draws (1e6)")
     st.add_argument("--seed", type=int, default=20110801, metavar="S", help="random seed (printed)")
-    st.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
-                    help=f"road crossfall [%%], in {_help_range('crossfall')}")
+    st.add_argument("--crossfall-percent", type=ranged("crossfall", what="road crossfall in %"), metavar="C",
+                    help=f"road crossfall [%%], in {help_range('crossfall')}")
     st.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
                     help="thrust angle of an axle [rad]; repeatable or comma-separated")
     st.add_argument("--json", action="store_true", help="machine-readable output")
@@ -237,8 +237,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="measured tires: CSV id,conicity_N,ply_steer_N[,conicity_moment_Nm,ply_steer_moment_Nm]")
     pl.add_argument("--positions", metavar="POS,POS,...",
                     help="positions to fill, axle:slot (default: every tire position of units 2..N)")
-    pl.add_argument("--crossfall-percent", type=_ranged("crossfall", what="road crossfall in %"), metavar="C",
-                    help=f"road crossfall [%%], in {_help_range('crossfall')}")
+    pl.add_argument("--crossfall-percent", type=ranged("crossfall", what="road crossfall in %"), metavar="C",
+                    help=f"road crossfall [%%], in {help_range('crossfall')}")
     pl.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
                     help="thrust angle of an axle [rad]; repeatable or comma-separated")
     pl.add_argument("--draws", type=int, default=10_000, metavar="N", help="random placements to compare (1e4)")
@@ -247,20 +247,20 @@ def build_parser() -> argparse.ArgumentParser:
     turn = sub.add_parser("turn", help="low-speed turn (90 deg by default): swept width, offtracking, tail and "
                                        "frontal swing (kinematic model, docs/low_speed_turn.md)")
     source(turn, masses=False)
-    turn.add_argument("--radius", type=_ranged("turn_radius", what="outside steer wheel radius in m"), default=12.5,
+    turn.add_argument("--radius", type=ranged("turn_radius", what="outside steer wheel radius in m"), default=12.5,
                       metavar="R", help=f"radius of the outside steer wheel's path [m], in "
-                                        f"{_help_range('turn_radius')}; default 12.5")
-    turn.add_argument("--angle-deg", type=_ranged("turn_angle", what="turn angle in deg"), default=90.0, metavar="A",
-                      help=f"angle of the turn [deg], in {_help_range('turn_angle')}; default 90")
+                                        f"{help_range('turn_radius')}; default 12.5")
+    turn.add_argument("--angle-deg", type=ranged("turn_angle", what="turn angle in deg"), default=90.0, metavar="A",
+                      help=f"angle of the turn [deg], in {help_range('turn_angle')}; default 90")
     turn.add_argument("--plot", metavar="FILE", help="draw the swept path into FILE (.png, .pdf or .svg; a new file)")
     turn.add_argument("--model", default="kinematic", choices=("kinematic", "nonlinear"),
                       help="the kinematic model (default: no forces) or the nonlinear model with tire forces "
                            "(friction demand, docs/nonlinear.md)")
-    turn.add_argument("--speed-kph", type=_ranged("speed", factor=3.6, unit="km/h", what="turn speed in km/h"),
+    turn.add_argument("--speed-kph", type=ranged("speed", factor=3.6, unit="km/h", what="turn speed in km/h"),
                       default=None, metavar="V", help="with --model nonlinear: unit 1's speed [km/h]; default 5")
-    turn.add_argument("--friction-coefficient", type=_ranged("friction", what="friction coefficient mu"),
+    turn.add_argument("--friction-coefficient", type=ranged("friction", what="friction coefficient mu"),
                       metavar="MU", default=None, help="with --model nonlinear: mu, in (0, 2]; default 0.8")
-    turn.add_argument("--path-gain", type=_ranged("path_gain", what="path gain in rad/m"), metavar="K",
+    turn.add_argument("--path-gain", type=ranged("path_gain", what="path gain in rad/m"), metavar="K",
                       default=None, help="with --model nonlinear: the path-following law's gain [rad/m]; default 2 (and its integral term, docs/nonlinear.md)")
     turn.add_argument("--tire", choices=("saturating", "linear"), default=None,
                       help="with --model nonlinear: the tire law; default saturating")
@@ -296,7 +296,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="residual force P [N] (+y) and moment T [N*m] (+z) on an axle, a source of the trim and "
                           "the straight path; repeatable (the crossfall is the scheme's crossfall_percent)")
     ass.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
-                     help=f"thrust angle of an axle [rad], in {_help_range('misalignment')}; repeatable or "
+                     help=f"thrust angle of an axle [rad], in {help_range('misalignment')}; repeatable or "
                           f"comma-separated")
     ass.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML): their axle P and T")
     ass.add_argument("--out", metavar="DIR", help="also write the assessment report (HTML, PDF; the verdict table "
@@ -314,10 +314,10 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-COMMANDS = {"presets": _cmd_presets, "eig": _cmd_eig, "matrices": _cmd_matrices, "steady": _cmd_steady,
-            "simulate": _cmd_simulate, "measures": _cmd_measures, "fmu": _cmd_fmu, "report": _cmd_report,
-            "tracking": _cmd_tracking, "turn": _cmd_turn, "study": _cmd_study, "roll": _cmd_roll,
-            "assess": _cmd_assess}
+COMMANDS = {"presets": cmd_presets, "eig": cmd_eig, "matrices": cmd_matrices, "steady": cmd_steady,
+            "simulate": cmd_simulate, "measures": cmd_measures, "fmu": cmd_fmu, "report": cmd_report,
+            "tracking": cmd_tracking, "turn": cmd_turn, "study": cmd_study, "roll": cmd_roll,
+            "assess": cmd_assess}
 
 
 def run(argv: Sequence[str] | None = None, out=None) -> int:
@@ -328,7 +328,7 @@ def run(argv: Sequence[str] | None = None, out=None) -> int:
     previous = None
     try:
         args = build_parser().parse_args(argv)
-        writer = _Out(stream)
+        writer = Output(stream)
         if threading.current_thread() is threading.main_thread():
             # a batch system's SIGTERM (a time limit) ends any command as Ctrl-C does: what it was
             # writing aside is removed, nothing half-written is left
@@ -340,29 +340,29 @@ def run(argv: Sequence[str] | None = None, out=None) -> int:
         print("lcv: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except UsageError as exc:
-        print(f"lcv: error: {_line(exc)}", file=sys.stderr)
+        print(f"lcv: error: {one_line(exc)}", file=sys.stderr)
         return 2
     except (RangeError, KeyError) as exc:
-        print(f"lcv: error: {_line(exc.args[0] if exc.args else exc)}", file=sys.stderr)
+        print(f"lcv: error: {one_line(exc.args[0] if exc.args else exc)}", file=sys.stderr)
         return 2
     except BrokenPipeError:
         _silence_stdout()
         return EXIT_BROKEN_PIPE
     except OutputError as exc:
-        print(f"lcv: error: {_line(exc)}", file=sys.stderr)
+        print(f"lcv: error: {one_line(exc)}", file=sys.stderr)
         return 1
     except OSError as exc:
         if exc.errno == errno.EPIPE:
             _silence_stdout()
             return EXIT_BROKEN_PIPE
-        print(f"lcv: error: cannot write the output: {_line(exc.strerror or exc)}", file=sys.stderr)
+        print(f"lcv: error: cannot write the output: {one_line(exc.strerror or exc)}", file=sys.stderr)
         _silence_stdout()
         return 1
     except FloatingPointError as exc:
-        print(f"lcv: error: {_line(exc)}", file=sys.stderr)
+        print(f"lcv: error: {one_line(exc)}", file=sys.stderr)
         return 1
     except Exception as exc:  # noqa: BLE001 - one line, never a traceback
-        print(f"lcv: internal error: {type(exc).__name__}: {_line(exc)} (please report this)", file=sys.stderr)
+        print(f"lcv: internal error: {type(exc).__name__}: {one_line(exc)} (please report this)", file=sys.stderr)
         return 1
     finally:
         if previous is not None:

@@ -7,17 +7,17 @@ from __future__ import annotations
 
 from ..measures.registry import MEASURES
 from ..units import mps_to_kph
-from .options import UsageError, _line, _load_units, _parse_speeds, _sources, _vehicle
-from .output import _finite, _Out
+from .options import UsageError, one_line, load_units_of, parse_speeds, sources_of, vehicle_of
+from .output import check_finite, Output
 
 
-def _cmd_measures(args, out: _Out) -> int:
+def cmd_measures(args, out: Output) -> int:
     from ..measures.criteria import CriteriaError, judge, load_criteria
     from ..measures.measure_set import measure_set
-    v = _vehicle(args)
-    speeds, unit = _parse_speeds(args)
-    units = _load_units(args, v) if args.load is not None else None
-    sources = _sources(args, v)
+    v = vehicle_of(args)
+    speeds, unit = parse_speeds(args)
+    units = load_units_of(args, v) if args.load is not None else None
+    sources = sources_of(args, v)
     criteria = None
     if args.criteria is not None:
         try:
@@ -36,7 +36,7 @@ def _cmd_measures(args, out: _Out) -> int:
         try:
             build_model(v, model)
         except (VehicleError, ValueError) as exc:
-            raise UsageError(f"argument --model {args.model}: {_line(exc)}") from None
+            raise UsageError(f"argument --model {args.model}: {one_line(exc)}") from None
     docs, sets = [], []
     for u in speeds:
         try:
@@ -52,7 +52,7 @@ def _cmd_measures(args, out: _Out) -> int:
         docs.append(doc)
         sets.append(m)
     for doc in docs:
-        _finite(*(val for val in doc.values() if isinstance(val, (int, float))),
+        check_finite(*(val for val in doc.values() if isinstance(val, (int, float))),
                 *(val for val in doc.values() if isinstance(val, list) and val and not isinstance(val[0], dict)))
     sweep = len(speeds) > 1
     if args.json:

@@ -7,12 +7,12 @@ import numpy as np
 
 from ..model.linear import linear_model
 from ..units import SI, THESIS
-from .options import _load_vector, _speed_mps, _speed_text, _vehicle
-from .output import _finite, _Out
+from .options import load_vector_of, speed_mps_of, speed_text, vehicle_of
+from .output import check_finite, Output
 
 
 # ---------------------------------------------------------------------------- commands
-def _cmd_presets(args, out: _Out) -> int:
+def cmd_presets(args, out: Output) -> int:
     from ..model.presets import PRESET_LABELS, PRESETS
     if args.json:
         out.json({"presets": list(PRESETS)})
@@ -22,7 +22,7 @@ def _cmd_presets(args, out: _Out) -> int:
     return 0
 
 
-def _cmd_eig(args, out: _Out) -> int:
+def cmd_eig(args, out: Output) -> int:
     from ..analysis.modes import modes
     from ..model.linear import check_model
     model = check_model(args.model)
@@ -30,14 +30,14 @@ def _cmd_eig(args, out: _Out) -> int:
         from .roll import roll_vehicle
         v = roll_vehicle(args)                    # the roll keys, checked: one line naming what is missing
     else:
-        v = _vehicle(args)
-    m = modes(v, _speed_mps(args), args.tire_scale, model=model)
-    _finite(m.eigenvalues)
+        v = vehicle_of(args)
+    m = modes(v, speed_mps_of(args), args.tire_scale, model=model)
+    check_finite(m.eigenvalues)
     k = m.least_damped
     if args.json:
         out.json(m.to_dict())
         return 0
-    out.line(f"{v.name} at {_speed_text(args)}, tire scale {args.tire_scale:g} "
+    out.line(f"{v.name} at {speed_text(args)}, tire scale {args.tire_scale:g} "
              f"({'stable' if m.stable else 'UNSTABLE'}); modes by real part, * = least damped")
     out.line(f"{'mode':>4} {'Re [1/s]':>10} {'Im [1/s]':>10} {'f_d [Hz]':>9} {'zeta [-]':>9}")
     for row in m.table():
@@ -47,14 +47,14 @@ def _cmd_eig(args, out: _Out) -> int:
     return 0
 
 
-def _cmd_matrices(args, out: _Out) -> int:
+def cmd_matrices(args, out: Output) -> int:
     from ..model.yaw_plane.equations import system_matrices
-    v = _vehicle(args)
+    v = vehicle_of(args)
     which = args.units or ("thesis" if args.preset is not None else "si")
     units = THESIS if which == "thesis" else SI
-    M, S = system_matrices(v, _speed_mps(args), args.tire_scale, units=units)
-    F = _load_vector(args, v, units) if args.load is not None else None
-    _finite(M, S, F)
+    M, S = system_matrices(v, speed_mps_of(args), args.tire_scale, units=units)
+    F = load_vector_of(args, v, units) if args.load is not None else None
+    check_finite(M, S, F)
     label = "thesis units: lbf, in, s" if units is THESIS else "SI: N, m, kg, s"
     if args.json:
         doc = {"state": list(linear_model(v).state_names), "units": label, "M": M.tolist(), "S": S.tolist()}
@@ -73,21 +73,21 @@ def _cmd_matrices(args, out: _Out) -> int:
     return 0
 
 
-def _cmd_steady(args, out: _Out) -> int:
+def cmd_steady(args, out: Output) -> int:
     from ..analysis.steady import steady_state
     from ..model.yaw_plane.outputs import rear_offsets
-    v = _vehicle(args)
-    F = _load_vector(args, v)
-    x = steady_state(v, _speed_mps(args), F, args.tire_scale)
+    v = vehicle_of(args)
+    F = load_vector_of(args, v)
+    x = steady_state(v, speed_mps_of(args), F, args.tire_scale)
     n = v.n_units
     y = rear_offsets(v, x[n + 1:])
-    _finite(x, y)
+    check_finite(x, y)
     state = {name: float(value) for name, value in zip(linear_model(v).state_names, x)}
     ydoc = {f"y{k + 2}": float(val) for k, val in enumerate(y)}
     if args.json:
         out.json({"state": state, "y": ydoc})
         return 0
-    out.line(f"steady state, {v.name} at {_speed_text(args)}, load on {args.load} ({args.convention} convention)")
+    out.line(f"steady state, {v.name} at {speed_text(args)}, load on {args.load} ({args.convention} convention)")
     for name, value in state.items():
         unit = "m/s" if name == "v1" else "rad/s" if name.startswith("r") else "rad"
         extra = f"  ({math.degrees(value):.4f} deg)" if name.startswith("theta") else ""

@@ -24,7 +24,7 @@ def _number(text: str, what: str) -> float:
         raise argparse.ArgumentTypeError(f"must be a number ({what}), got {text!r}") from None
 
 
-def _ranged(key: str, factor: float = 1.0, unit: str | None = None, what: str = ""):
+def ranged(key: str, factor: float = 1.0, unit: str | None = None, what: str = ""):
     r = RANGES[key]
 
     def conv(text: str) -> float:
@@ -36,13 +36,13 @@ def _ranged(key: str, factor: float = 1.0, unit: str | None = None, what: str = 
     return conv
 
 
-def _help_range(key: str, factor: float = 1.0, unit: str | None = None) -> str:
+def help_range(key: str, factor: float = 1.0, unit: str | None = None) -> str:
     """The valid range of ``key`` for a help text (argparse formats help with %: a unit of % is doubled)."""
     return RANGES[key].text(factor, unit).replace("%", "%%")
 
 
 # ---------------------------------------------------------------------------- inputs
-def _vehicle(args: argparse.Namespace):
+def vehicle_of(args: argparse.Namespace):
     from ..model.presets import PRESETS, load_preset
     from ..model.vehicle import VehicleError
     from ..model.vehicle_file import load_vehicle
@@ -61,11 +61,11 @@ def _vehicle(args: argparse.Namespace):
         raise UsageError(f"argument --vehicle {args.vehicle}: {exc}") from None
     from ..model.plausibility import plausibility_warnings
     for line in plausibility_warnings(v):
-        print(f"lcv: warning: {_line(args.vehicle)}: {_line(line)}", file=sys.stderr)
+        print(f"lcv: warning: {one_line(args.vehicle)}: {one_line(line)}", file=sys.stderr)
     return v
 
 
-def _plot_path(args: argparse.Namespace):
+def plot_path_of(args: argparse.Namespace):
     """The new figure file of ``--plot`` (None without it): .png, .pdf or .svg, not an existing
     file, in an existing folder."""
     from pathlib import Path
@@ -81,19 +81,19 @@ def _plot_path(args: argparse.Namespace):
     return plot
 
 
-def _speed_mps(args: argparse.Namespace) -> float:
+def speed_mps_of(args: argparse.Namespace) -> float:
     if getattr(args, "speed_kph", None) is not None:
         return args.speed_kph * MPS_PER_KPH
     return args.speed_mph * MPS_PER_MPH
 
 
-def _speed_text(args: argparse.Namespace) -> str:
+def speed_text(args: argparse.Namespace) -> str:
     if getattr(args, "speed_kph", None) is not None:
         return f"{args.speed_kph:g} km/h"
     return f"{args.speed_mph:g} mph"
 
 
-def _load_units(args: argparse.Namespace, vehicle) -> list[str]:
+def load_units_of(args: argparse.Namespace, vehicle) -> list[str]:
     from ..model.yaw_plane.loads import check_unit_names
     names = [s.strip() for s in args.load.split(",")]
     valid = ",".join(vehicle.unit_names)
@@ -105,14 +105,14 @@ def _load_units(args: argparse.Namespace, vehicle) -> list[str]:
         raise UsageError(f"argument --load: {exc.args[0]}") from None
 
 
-def _load_vector(args: argparse.Namespace, vehicle, units=SI, model: str = "yaw_plane") -> np.ndarray:
-    return _one_percent_vector(args, vehicle, units, model)[0]
+def load_vector_of(args: argparse.Namespace, vehicle, units=SI, model: str = "yaw_plane") -> np.ndarray:
+    return one_percent_vector_of(args, vehicle, units, model)[0]
 
 
-def _one_percent_vector(args: argparse.Namespace, vehicle, units=SI, model: str = "yaw_plane"):
+def one_percent_vector_of(args: argparse.Namespace, vehicle, units=SI, model: str = "yaw_plane"):
     """(F, P per axle [N]) of the 1 % rule on ``--load``."""
     from ..model.yaw_plane.loads import load_vector, one_percent_rule
-    names = _load_units(args, vehicle)
+    names = load_units_of(args, vehicle)
     try:
         res = one_percent_rule(vehicle, names, t_sign=1.0)
     except ValueError as exc:
@@ -120,13 +120,13 @@ def _one_percent_vector(args: argparse.Namespace, vehicle, units=SI, model: str 
     return load_vector(vehicle, res, args.convention, units, model), res.vectors(vehicle)[0]
 
 
-def _source_force(args: argparse.Namespace, vehicle):
+def source_force_of(args: argparse.Namespace, vehicle):
     """The generalized force [SI] of the residual sources of the options (None if none)."""
-    src = _sources(args, vehicle)
+    src = sources_of(args, vehicle)
     return src.vector(vehicle, args.tire_scale) if src else None
 
 
-def _sources(args: argparse.Namespace, vehicle):
+def sources_of(args: argparse.Namespace, vehicle):
     """The residual sources of ``--residual``, ``--misalignment``, ``--crossfall-percent``."""
     from ..model.yaw_plane.loads import ResidualLoads, ResidualSources
     axles = vehicle.axle_names
@@ -184,7 +184,7 @@ def _sources(args: argparse.Namespace, vehicle):
     return ResidualSources(ResidualLoads(P, T), eps, crossfall)
 
 
-def _parse_speeds(args: argparse.Namespace) -> tuple[list[float], str]:
+def parse_speeds(args: argparse.Namespace) -> tuple[list[float], str]:
     """Speeds [m/s] of ``--speed-kph``/``--speed-mph`` (one, or START:STOP:STEP) and the unit."""
     text, unit, factor = (args.speed_kph, "km/h", MPS_PER_KPH) if args.speed_kph is not None else \
         (args.speed_mph, "mph", MPS_PER_MPH)
@@ -218,14 +218,14 @@ def _parse_speeds(args: argparse.Namespace) -> tuple[list[float], str]:
 MESSAGE_CHARS = 600
 
 
-def _line(text) -> str:
+def one_line(text) -> str:
     """``text`` as one short line of plain text: every character that is not printable (a newline,
     an ESC that would drive the terminal) escaped, so a message quoting a user's file is one line;
     at most :data:`MESSAGE_CHARS` characters (the cut marked and counted).
 
     Examples
     --------
-    >>> _line("a\\nb"), len(_line("x" * 10_000)) <= MESSAGE_CHARS
+    >>> one_line("a\\nb"), len(one_line("x" * 10_000)) <= MESSAGE_CHARS
     ('a\\\\nb', True)
     """
     line = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in str(text))

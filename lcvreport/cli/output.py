@@ -16,7 +16,7 @@ class OutputError(Exception):
 
 
 # ---------------------------------------------------------------------------- output
-class _Out:
+class Output:
     """Writes to a stream; turns write failures into :class:`OutputError` and refuses
     non-finite numbers."""
 
@@ -42,13 +42,13 @@ class _Out:
         self.line(text)
 
 
-def _finite(*arrays) -> None:
+def check_finite(*arrays) -> None:
     for a in arrays:
         if a is not None and not np.all(np.isfinite(np.asarray(a, dtype=complex))):
             raise OutputError("the result is not finite (a number is inf or NaN); nothing was written")
 
 
-def _write_figure_new(fig, path: Path) -> None:
+def write_figure_new(fig, path: Path) -> None:
     """Save a figure to a new file: written aside, then linked into place (never over a file)."""
     import os
     import tempfile

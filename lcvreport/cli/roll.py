@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import sys
 
-from .options import UsageError, _line, _plot_path, _speed_mps, _vehicle
-from .output import _Out, _write_figure_new
+from .options import UsageError, one_line, plot_path_of, speed_mps_of, vehicle_of
+from .output import Output, write_figure_new
 
 
 def roll_vehicle(args):
@@ -13,24 +13,24 @@ def roll_vehicle(args):
     static loads that disagree with the masses: one warning line)."""
     from ..model.vehicle import VehicleError
     from ..model.yaw_roll.parameters import roll_parameters
-    v = _vehicle(args)
+    v = vehicle_of(args)
     try:
         rp = roll_parameters(v)
     except VehicleError as exc:
         where = f"--vehicle {args.vehicle}" if args.vehicle else f"--preset {args.preset}"
         raise UsageError(f"argument {where}: {exc}") from None
     if rp.load_warning:
-        print(f"lcv: {_line(rp.load_warning)}", file=sys.stderr)
+        print(f"lcv: {one_line(rp.load_warning)}", file=sys.stderr)
     return v
 
 
-def _cmd_roll(args, out: _Out) -> int:
+def cmd_roll(args, out: Output) -> int:
     from ..measures.roll import roll_summary, unstable_at_rest_note
     v = roll_vehicle(args)
-    plot = _plot_path(args)
-    s = roll_summary(v, _speed_mps(args), args.tire_scale)
+    plot = plot_path_of(args)
+    s = roll_summary(v, speed_mps_of(args), args.tire_scale)
     if plot is not None:
-        _write_figure_new(s.plot(), plot)
+        write_figure_new(s.plot(), plot)
     if args.json:
         out.json(s.to_dict())
         return 0
@@ -46,14 +46,14 @@ def _cmd_roll(args, out: _Out) -> int:
     if note:
         out.line(f"  {note}")
     if doc["roll_gain_deg_per_g"] is None:
-        out.line(f"  roll gains not computed: {_line(doc['reasons'].get('roll_gain_deg_per_g', ''))}")
+        out.line(f"  roll gains not computed: {one_line(doc['reasons'].get('roll_gain_deg_per_g', ''))}")
     for name, gain in (doc["roll_gain_deg_per_g"] or {}).items():
         out.line(f"  roll gain, {name:<16} {fmt(gain, '.3f'):>8} deg/g")
     for key, label in (("ltr_lane_change", "LTR, lane change 0.15 g 0.4 Hz"),
                        ("ltr_single_sine", "LTR, single sine 0.4 Hz, 0.15 g")):
         values = doc[key]
         text = ", ".join(f"{x:.3f}" for x in values) if values is not None else \
-            f"not computed: {_line(doc['reasons'].get(key, ''))}"
+            f"not computed: {one_line(doc['reasons'].get(key, ''))}"
         out.line(f"  {label:<34} {text}  (per group, front to rear)")
     out.line(f"  roll-model least damping ratio     {fmt(doc['roll_least_damping_ratio'], '.4f')}")
     crit = doc["roll_critical_speed_kph"]

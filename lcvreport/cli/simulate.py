@@ -9,14 +9,14 @@ import numpy as np
 from ..model.base import MODELS, check_model
 from ..model.linear import linear_model
 from ..ranges import RANGES, RangeError
-from .options import UsageError, _line, _one_percent_vector, _sources, _speed_mps, _vehicle
-from .output import _finite, _Out
+from .options import UsageError, one_line, one_percent_vector_of, sources_of, speed_mps_of, vehicle_of
+from .output import check_finite, Output
 
 
-def _cmd_simulate(args, out: _Out) -> int:
+def cmd_simulate(args, out: Output) -> int:
     from ..analysis.exact import ManoeuvreError, check_lane_change_steer, final_state, response
     from ..manoeuvres.steer import SteerError, parse_steer, step
-    v = _vehicle(args)
+    v = vehicle_of(args)
     steps_f = args.t_end / args.dt
     steps = int(round(steps_f))
     if args.dt > args.t_end:
@@ -44,16 +44,16 @@ def _cmd_simulate(args, out: _Out) -> int:
         raise UsageError("arguments --tire/--friction-coefficient: the nonlinear model's (--model nonlinear)")
     axle_force = np.zeros(len(v.axles))
     if args.load is not None:
-        F, axle_force = _one_percent_vector(args, v, model=model)
+        F, axle_force = one_percent_vector_of(args, v, model=model)
     else:
         F = np.zeros(linear_model(v, model).n_states)
     try:
-        src = _sources(args, v)
+        src = sources_of(args, v)
         F = F + src.vector(v, args.tire_scale, model)
         axle_force = axle_force + src.axle_forces(v, args.tire_scale)
     except (KeyError, RangeError) as exc:
         raise UsageError(f"argument: {exc.args[0]}") from None
-    u = _speed_mps(args)
+    u = speed_mps_of(args)
     chunk = 20000                                  # rows per exact run: constant memory
     first = True
     state, k = None, 0
@@ -67,7 +67,7 @@ def _cmd_simulate(args, out: _Out) -> int:
         except ManoeuvreError as exc:
             raise UsageError(f"argument --steer: {exc}") from None
         M = r.matrix()
-        _finite(M)
+        check_finite(M)
         if first:
             names = r.columns()
             if args.json:
@@ -89,7 +89,7 @@ def _cmd_simulate(args, out: _Out) -> int:
     return 0
 
 
-def _simulate_nonlinear(args, out: _Out, v, steer, steps: int) -> int:
+def _simulate_nonlinear(args, out: Output, v, steer, steps: int) -> int:
     """``lcv simulate --model nonlinear``: the nonlinear model integrated (docs/nonlinear.md), the
     columns of its outputs; a lane change of the inverse system is a linear model's (refused)."""
     from ..analysis.integrate import IntegrationError, integrate
@@ -101,19 +101,19 @@ def _simulate_nonlinear(args, out: _Out, v, steer, steps: int) -> int:
         m = build_model(v, "nonlinear", tire=args.tire or "saturating",
                         friction_coefficient=0.8 if args.friction_coefficient is None else args.friction_coefficient)
     except (VehicleError, ValueError) as exc:
-        raise UsageError(f"argument --model nonlinear: {_line(exc)}") from None
+        raise UsageError(f"argument --model nonlinear: {one_line(exc)}") from None
     try:
-        src = _sources(args, v)
+        src = sources_of(args, v)
         src.vector(v, args.tire_scale)                    # each source checked against the vehicle
     except (KeyError, RangeError) as exc:
         raise UsageError(f"argument: {exc.args[0]}") from None
     try:
-        r = integrate(m, steer, _speed_mps(args), steps * args.dt, args.dt, args.tire_scale,
+        r = integrate(m, steer, speed_mps_of(args), steps * args.dt, args.dt, args.tire_scale,
                       sources=src if src else None)
     except IntegrationError as exc:
-        raise UsageError(f"argument --steer: {_line(exc)}") from None
+        raise UsageError(f"argument --steer: {one_line(exc)}") from None
     M = r.matrix() + 0.0                                  # no -0 printed
-    _finite(M)
+    check_finite(M)
     names = r.columns()
     if args.json:
         out.write('{"columns": ' + json.dumps(names) + ', "rows": [')

@@ -3,28 +3,28 @@ from __future__ import annotations
 
 import math
 
-from .options import UsageError, _source_force, _speed_mps, _speed_text, _vehicle
-from .output import _Out
+from .options import UsageError, source_force_of, speed_mps_of, speed_text, vehicle_of
+from .output import Output
 
 
 def _trimmed_vehicle(args):
     """The vehicle of the options; it needs a steered axle (the trim's)."""
-    v = _vehicle(args)
+    v = vehicle_of(args)
     if not v.steered_axles:
         raise UsageError(f"argument --vehicle: {v.name} has no steered axle: the trim needs one")
     return v
 
 
-def _json_or_heading(out: _Out, args, result, vehicle, heading: str) -> bool:
+def _json_or_heading(out: Output, args, result, vehicle, heading: str) -> bool:
     """``result.to_dict()`` as the JSON of ``--json`` (True: done), else the text's first line."""
     if args.json:
         out.json(result.to_dict())
         return True
-    out.line(f"{vehicle.name} at {_speed_text(args)}: {heading}")
+    out.line(f"{vehicle.name} at {speed_text(args)}: {heading}")
     return False
 
 
-def _cmd_place(args, out: _Out) -> int:
+def _cmd_place(args, out: Output) -> int:
     from ..tracking.placement import place_tires, read_measured_tires
     from ..tracking.tires import TrackingError
     v = _trimmed_vehicle(args)
@@ -37,9 +37,9 @@ def _cmd_place(args, out: _Out) -> int:
     except TrackingError as exc:
         raise UsageError(f"argument --tires: {exc}") from None
     positions = [p.strip() for p in args.positions.split(",")] if args.positions else None
-    F = _source_force(args, v)
+    F = source_force_of(args, v)
     try:
-        pl = place_tires(v, _speed_mps(args), tires, positions, F, args.tire_scale, args.draws, args.seed)
+        pl = place_tires(v, speed_mps_of(args), tires, positions, F, args.tire_scale, args.draws, args.seed)
     except TrackingError as exc:
         opt = "--positions" if str(exc).startswith("position") else "--tires"
         raise UsageError(f"argument {opt}: {exc}") from None
@@ -59,7 +59,7 @@ def _cmd_place(args, out: _Out) -> int:
     return 0
 
 
-def _cmd_tracking(args, out: _Out) -> int:
+def cmd_tracking(args, out: Output) -> int:
     if args.tracking_command == "place":
         return _cmd_place(args, out)
     from ..tracking.statistics import ZERO, parse_distribution, tracking_stats
@@ -79,9 +79,9 @@ def _cmd_tracking(args, out: _Out) -> int:
         if not (math.isfinite(val) and 0 < val <= 10):
             raise UsageError(f"argument {opt}: must be in (0, 10] m, got {val:g}")
     axles = [a.strip() for a in args.axles.split(",")] if args.axles else None
-    F = _source_force(args, v)
+    F = source_force_of(args, v)
     try:
-        s = tracking_stats(v, _speed_mps(args), dists["conicity"], dists["ply_steer"], args.mounting,
+        s = tracking_stats(v, speed_mps_of(args), dists["conicity"], dists["ply_steer"], args.mounting,
                            dists["conicity_moment"], dists["ply_steer_moment"], axles, args.lane_width_m,
                            args.body_width_m, args.draws, args.seed, F, args.tire_scale)
     except TrackingError as exc:

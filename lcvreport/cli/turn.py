@@ -1,15 +1,15 @@
 """``lcv turn``: the low-speed turn and its measures, with the swept-path figure."""
 from __future__ import annotations
 
-from .options import UsageError, _line, _plot_path, _vehicle
-from .output import _Out, _write_figure_new
+from .options import UsageError, one_line, plot_path_of, vehicle_of
+from .output import Output, write_figure_new
 
 
-def _cmd_turn(args, out: _Out) -> int:
+def cmd_turn(args, out: Output) -> int:
     from ..measures.low_speed import low_speed_turn
     from ..model.body import TurnError
-    v = _vehicle(args)
-    plot = _plot_path(args)
+    v = vehicle_of(args)
+    plot = plot_path_of(args)
     if args.model == "nonlinear":
         return _turn_nonlinear(args, out, v, plot)
     for name in ("speed_kph", "friction_coefficient", "path_gain", "tire"):
@@ -20,7 +20,7 @@ def _cmd_turn(args, out: _Out) -> int:
     except TurnError as exc:
         raise UsageError(f"argument --{'vehicle' if args.vehicle else 'preset'}: {exc}") from None
     if plot is not None:
-        _write_figure_new(t.plot(), plot)
+        write_figure_new(t.plot(), plot)
     if args.json:
         out.json(t.to_dict())
         return 0
@@ -32,17 +32,17 @@ def _cmd_turn(args, out: _Out) -> int:
                               ("low-speed offtracking", "low_speed_offtracking_m", t.low_speed_offtracking_m),
                               ("frontal swing", "frontal_swing_m", t.frontal_swing_m)):
         out.line(f"  {label:<25} {value:8.3f} m" if value is not None else
-                 f"  {label:<25} not computed: {_line(t.undefined.get(key, ''))}")
+                 f"  {label:<25} not computed: {one_line(t.undefined.get(key, ''))}")
     for name, val in t.tail_swing_m.items():
         out.line(f"  tail swing, {name:<13} {val:8.3f} m")
     if not t.tail_swing_m:
-        out.line(f"  {'tail swing':<25} not computed: {_line(t.undefined.get('max_tail_swing_m', ''))}")
+        out.line(f"  {'tail swing':<25} not computed: {one_line(t.undefined.get('max_tail_swing_m', ''))}")
     if plot is not None:
         out.line(f"wrote {plot}")
     return 0
 
 
-def _turn_nonlinear(args, out: _Out, v, plot) -> int:
+def _turn_nonlinear(args, out: Output, v, plot) -> int:
     """``lcv turn --model nonlinear``: the turn with tire forces, friction demand per axle."""
     from ..analysis.integrate import IntegrationError
     from ..measures.friction_demand import (PATH_GAIN_RAD_PER_M, TURN_SPEED_KPH, turn_with_tire_forces)
@@ -56,11 +56,11 @@ def _turn_nonlinear(args, out: _Out, v, plot) -> int:
                                   PATH_GAIN_RAD_PER_M if args.path_gain is None else args.path_gain,
                                   tire=args.tire or "saturating")
     except (TurnError, VehicleError, ValueError) as exc:
-        raise UsageError(f"argument --{'vehicle' if args.vehicle else 'preset'}: {_line(exc)}") from None
+        raise UsageError(f"argument --{'vehicle' if args.vehicle else 'preset'}: {one_line(exc)}") from None
     except IntegrationError as exc:
-        raise UsageError(f"argument --speed-kph: {_line(exc)}") from None
+        raise UsageError(f"argument --speed-kph: {one_line(exc)}") from None
     if plot is not None:
-        _write_figure_new(t.plot(), plot)
+        write_figure_new(t.plot(), plot)
     if args.json:
         out.json(t.to_dict())
         return 0
@@ -71,7 +71,7 @@ def _turn_nonlinear(args, out: _Out, v, plot) -> int:
     for label, key, value in (("steer-tyre friction demand", "stfd", t.stfd),
                               ("drive-tyre friction demand", "friction_demand_drive", t.friction_demand_drive)):
         out.line(f"  {label:<30} {value:8.3f}" if value is not None else
-                 f"  {label:<30} not computed: {_line(t.undefined.get(key, ''))}")
+                 f"  {label:<30} not computed: {one_line(t.undefined.get(key, ''))}")
     for axle, fd in t.friction_demand.items():
         out.line(f"  friction demand, axle {axle:<9} {fd:8.3f}")
     for label, key in (("swept width (lssp)", "lssp_m"), ("low-speed offtracking", "low_speed_offtracking_m"),

@@ -36,14 +36,14 @@ from pathlib import Path
 
 from ..model.vehicle import Vehicle
 from ..model.vehicle_file import dumps_vehicle
-from .c_sources import (EXPORT_LIB, EXPORT_LIBS, FmuBuildError, _compile, c_files, config_data_header, config_header,
+from .c_sources import (EXPORT_LIB, EXPORT_LIBS, FmuBuildError, compile_c, c_files, config_data_header, config_header,
                         fmi_header_dir, loader_config_header, shipped_sources, source_dir, vehicle_data_header)
 from .c_tree import (INCLUDE_DIRS, LOADER_HEADERS, LOADER_INCLUDE_DIRS, LOADER_SOURCES, NATIVE_HEADERS, NATIVE_SOURCES,
                      STUB_SOURCES)
 from .description_common import guid
 from .description_fmi2 import model_description
 from .interface import U_START, Interface, fmu_base_name, preset_interface, vehicle_interface
-from .package import SOURCES_README, _package_copy, _zip, bundled_package_name, documentation_files
+from .package import SOURCES_README, package_copy, write_zip, bundled_package_name, documentation_files
 
 
 def build_native_fmu(itf: Interface, out_dir: Path, model_identifier: str, stub: bool = False) -> Path:
@@ -62,7 +62,7 @@ def build_native_fmu(itf: Interface, out_dir: Path, model_identifier: str, stub:
         for name, text in generated.items():
             (tmp / name).write_text(text, encoding="utf-8")
         lib = tmp / f"{model_identifier}.so"
-        _compile(c_files(STUB_SOURCES if stub else NATIVE_SOURCES[2]), [tmp, *c_files(INCLUDE_DIRS), fmi_header_dir()],
+        compile_c(c_files(STUB_SOURCES if stub else NATIVE_SOURCES[2]), [tmp, *c_files(INCLUDE_DIRS), fmi_header_dir()],
                  lib, ["-lm"])
         files = {"modelDescription.xml": model_description(itf, model_identifier, native=True,
                                                            generation_tool="lcvreport.fmu.build (C99)"),
@@ -75,7 +75,7 @@ def build_native_fmu(itf: Interface, out_dir: Path, model_identifier: str, stub:
             if not itf.preset_mode:   # the vehicle built in, as its file (for the user; the C code does not read it)
                 files["resources/vehicle.toml"] = dumps_vehicle(itf.vehicles[0]).encode()
             files.update(documentation_files(itf, model_identifier, native=True))
-        return _zip(out_dir / f"{model_identifier}.fmu", files)
+        return write_zip(out_dir / f"{model_identifier}.fmu", files)
 
 
 def build_native_fmu3(itf: Interface, out_dir: Path, model_identifier: str) -> Path:
@@ -92,7 +92,7 @@ def build_native_fmu3(itf: Interface, out_dir: Path, model_identifier: str) -> P
         for name, text in generated.items():
             (tmp / name).write_text(text, encoding="utf-8")
         lib = tmp / f"{model_identifier}.so"
-        _compile(c_files(NATIVE_SOURCES[3]), [tmp, *c_files(INCLUDE_DIRS), fmi_header_dir()], lib, ["-lm"],
+        compile_c(c_files(NATIVE_SOURCES[3]), [tmp, *c_files(INCLUDE_DIRS), fmi_header_dir()], lib, ["-lm"],
                  defines=["LCV_FMI3"])
         files = {"modelDescription.xml": model_description3(itf, model_identifier,
                                                             generation_tool="lcvreport.fmu.build (C99)"),
@@ -104,7 +104,7 @@ def build_native_fmu3(itf: Interface, out_dir: Path, model_identifier: str) -> P
         if not itf.preset_mode:
             files["resources/vehicle.toml"] = dumps_vehicle(itf.vehicles[0]).encode()
         files.update(documentation_files(itf, model_identifier, native=True, fmi=3))
-        return _zip(out_dir / f"{model_identifier}.fmu", files)
+        return write_zip(out_dir / f"{model_identifier}.fmu", files)
 
 
 def _pythonfmu_build(tool: str, itf: Interface, tmp: Path, alias: str, script: str, script_text: str,
@@ -123,7 +123,7 @@ def _pythonfmu_build(tool: str, itf: Interface, tmp: Path, alias: str, script: s
     if not itf.preset_mode:
         (proj / "vehicle.toml").write_text(dumps_vehicle(itf.vehicles[0]), encoding="utf-8")
         extra.append(proj / "vehicle.toml")
-    _package_copy(proj, alias)
+    package_copy(proj, alias)
     built = tmp / "built"
     cmd = [sys.executable, "-m", tool, "build", "-f", str(proj / script), "-d", str(built),
            "--handle-state", "--serialize-state", *map(str, extra), str(proj / alias)]
@@ -166,7 +166,7 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
         (tmp / "loader_config.h").write_text(loader_config_header(itf, model_identifier, fmu_guid, env), "utf-8")
         loader = tmp / f"{model_identifier}.so"
         # Python.h for the types of the initialization API only (the loader links no libpython)
-        _compile(c_files(LOADER_SOURCES[2]),
+        compile_c(c_files(LOADER_SOURCES[2]),
                  [tmp, *c_files(LOADER_INCLUDE_DIRS), fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
                  ["-ldl", "-lpthread"])
         files[f"binaries/linux64/{model_identifier}.so"] = loader.read_bytes()
@@ -174,7 +174,7 @@ def build_python_fmu(itf: Interface, out_dir: Path, model_identifier: str, env: 
         files.update(shipped_sources(LOADER_SOURCES[2] + LOADER_HEADERS[2]))
         files["sources/loader_config.h"] = (tmp / "loader_config.h").read_bytes()
         files.update(documentation_files(itf, model_identifier, native=False))
-        return _zip(out_dir / f"{model_identifier}.fmu", files)
+        return write_zip(out_dir / f"{model_identifier}.fmu", files)
 
 
 #: pythonfmu3's export library inside the FMI 3.0 Python FMU (the loader, loader3.c, loads it)
@@ -214,7 +214,7 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
                                                            generation_tool="lcvreport.fmu.build (pythonfmu3 0.3.4)")
         (tmp / "loader_config.h").write_text(loader_config_header(itf, model_identifier, fmu_guid, env, fmi=3), "utf-8")
         loader = tmp / f"{model_identifier}.so"
-        _compile(c_files(LOADER_SOURCES[3]),
+        compile_c(c_files(LOADER_SOURCES[3]),
                  [tmp, *c_files(LOADER_INCLUDE_DIRS), fmi_header_dir(), Path(sysconfig.get_paths()["include"])], loader,
                  ["-ldl", "-lpthread"], defines=["LCV_FMI3"])
         files[f"binaries/x86_64-linux/{model_identifier}.so"] = loader.read_bytes()
@@ -222,7 +222,7 @@ def build_python_fmu3(itf: Interface, out_dir: Path, model_identifier: str, env:
         files.update(shipped_sources(LOADER_SOURCES[3] + LOADER_HEADERS[3]))
         files["sources/loader_config.h"] = (tmp / "loader_config.h").read_bytes()
         files.update(documentation_files(itf, model_identifier, native=False, fmi=3))
-        return _zip(out_dir / f"{model_identifier}.fmu", files)
+        return write_zip(out_dir / f"{model_identifier}.fmu", files)
 
 
 def build_preset_fmus(out_dir: Path) -> list[Path]:

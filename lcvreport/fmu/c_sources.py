@@ -262,7 +262,7 @@ def loader_config_header(itf: Interface, model_identifier: str, fmu_guid: str, e
 
 
 # ---------------------------------------------------------------------------- compiling and zipping
-def _compile(sources: list[Path], include: list[Path], out: Path, libs: list[str], defines=()) -> None:
+def compile_c(sources: list[Path], include: list[Path], out: Path, libs: list[str], defines=()) -> None:
     cmd = ["gcc", *CFLAGS, *[f"-D{d}" for d in defines], *[f"-I{d}" for d in include], "-o", str(out),
            *map(str, sources), *libs]
     try:

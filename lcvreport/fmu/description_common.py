@@ -53,7 +53,7 @@ DEFAULT_EXPERIMENT = {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.001
 FEEDTHROUGH = ("ay", "extra")
 
 
-def _state_dependencies(itf: Interface) -> dict:
+def state_dependencies(itf: Interface) -> dict:
     """Output name -> the continuous states it depends on (Model Exchange), from the engine's
     output maps of every vehicle of the FMU: linear outputs through C, rear offsets through
     the relative headings H, lateral accelerations through every state but psi1 and Y1."""
@@ -84,7 +84,7 @@ def unit_definitions(root: Element, names) -> Element:
         unit = SubElement(defs, "Unit", name=name)
         SubElement(unit, "BaseUnit", {k: str(e) for k, e in base.items()})
         for dname, factor in displays:
-            SubElement(unit, "DisplayUnit", {"name": dname, "factor": _num(factor)})
+            SubElement(unit, "DisplayUnit", {"name": dname, "factor": xml_number(factor)})
     return defs
 
 
@@ -113,13 +113,13 @@ def real_attributes(v: FmuVariable, declared: dict, nominal: dict) -> dict:
         attrs["displayUnit"] = v.display_unit
     if v.causality in ("parameter", "input"):
         if v.minimum is not None:
-            attrs["min"] = _num(v.minimum)
+            attrs["min"] = xml_number(v.minimum)
         if v.maximum is not None:
-            attrs["max"] = _num(v.maximum)
+            attrs["max"] = xml_number(v.maximum)
     if v.start is not None:
-        attrs["start"] = _num(v.start)
+        attrs["start"] = xml_number(v.start)
     if v.name in nominal:                     # a Model Exchange state: its physical scale
-        attrs["nominal"] = _num(nominal[v.name])
+        attrs["nominal"] = xml_number(nominal[v.name])
     return attrs
 
 
@@ -143,7 +143,7 @@ def declared_types(itf: Interface) -> dict:
     return out
 
 
-def _direct_dependencies(itf: Interface, v: FmuVariable, states: dict | None = None) -> list[str]:
+def direct_dependencies(itf: Interface, v: FmuVariable, states: dict | None = None) -> list[str]:
     """Inputs (feedthrough) and, with ``states``, continuous states an output depends on."""
     kind = v.source[0]
     out = set((states or {}).get(v.name, ()))
@@ -154,7 +154,7 @@ def _direct_dependencies(itf: Interface, v: FmuVariable, states: dict | None = N
     return list(out)
 
 
-def _initial_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
+def initial_dependencies(itf: Interface, v: FmuVariable) -> list[str]:
     """Inputs and parameters an output depends on at initialization."""
     kind = v.source[0]
     params = [p.name for p in itf.parameters]
@@ -200,5 +200,5 @@ def guid(itf: Interface, model_identifier: str) -> str:
     return "{" + str(uuid.UUID(bytes=h.digest()[:16], version=5)) + "}"
 
 
-def _num(x: float) -> str:
+def xml_number(x: float) -> str:
     return repr(float(x))

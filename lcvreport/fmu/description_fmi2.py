@@ -17,7 +17,7 @@ from __future__ import annotations
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from .c_tree import NATIVE_SOURCES, names
-from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial_dependencies, _state_dependencies,
+from .description_common import (UNIT_DERIVATIVE, direct_dependencies, initial_dependencies, state_dependencies,
                                  categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
                                  enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
@@ -104,19 +104,19 @@ def model_description(itf: Interface, model_identifier: str, native: bool, gener
             if UNIT_DERIVATIVE.get(sv.unit):
                 real["unit"] = UNIT_DERIVATIVE[sv.unit]
             SubElement(dv, "Real", real)
-    states = _state_dependencies(itf) if native else None
+    states = state_dependencies(itf) if native else None
     ms = SubElement(root, "ModelStructure")
     outs = SubElement(ms, "Outputs")
     if derivatives:
         ders = SubElement(ms, "Derivatives")
     init = SubElement(ms, "InitialUnknowns")
     for v in itf.outputs:                  # dependencies in ascending order (FMI 2.0.4, section 2.2.8)
-        deps = " ".join(str(i) for i in sorted(index[n] for n in _direct_dependencies(itf, v, states)))
+        deps = " ".join(str(i) for i in sorted(index[n] for n in direct_dependencies(itf, v, states)))
         SubElement(outs, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
     for name in derivatives:               # every state and input (no dependencies attribute: all)
         SubElement(ders, "Unknown", {"index": str(index[name])})
     for v in itf.outputs:
-        deps = " ".join(str(i) for i in sorted(index[n] for n in _initial_dependencies(itf, v)))
+        deps = " ".join(str(i) for i in sorted(index[n] for n in initial_dependencies(itf, v)))
         SubElement(init, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
     for name in derivatives:
         SubElement(init, "Unknown", {"index": str(index[name])})

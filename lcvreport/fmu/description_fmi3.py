@@ -18,7 +18,7 @@ from __future__ import annotations
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from .c_tree import NATIVE_SOURCES, names
-from .description_common import (UNIT_DERIVATIVE, _direct_dependencies, _initial_dependencies, _state_dependencies,
+from .description_common import (UNIT_DERIVATIVE, direct_dependencies, initial_dependencies, state_dependencies,
                                  categories_and_experiment, declared_types, enumeration_items, enumeration_type_name,
                                  enumeration_value, guid, real_attributes, unit_definitions, variable_attributes)
 from .interface import Interface
@@ -90,15 +90,15 @@ def model_description3(itf: Interface, model_identifier: str, generation_tool: s
             attrs["unit"] = UNIT_DERIVATIVE[sv.unit]
         SubElement(mv, "Float64", attrs)
     vr_of = {v.name: v.value_reference for v in itf.variables}
-    state_deps = _state_dependencies(itf) if native else None
+    state_deps = state_dependencies(itf) if native else None
     ms = SubElement(root, "ModelStructure")
     for v in itf.outputs:
-        deps = " ".join(str(i) for i in sorted(vr_of[n] for n in _direct_dependencies(itf, v, state_deps)))
+        deps = " ".join(str(i) for i in sorted(vr_of[n] for n in direct_dependencies(itf, v, state_deps)))
         SubElement(ms, "Output", {"valueReference": str(v.value_reference), "dependencies": deps})
     for sv in states:
         SubElement(ms, "ContinuousStateDerivative", {"valueReference": str(der_vr[sv.name])})
     for v in itf.outputs:
-        deps = " ".join(str(i) for i in sorted(vr_of[n] for n in _initial_dependencies(itf, v)))
+        deps = " ".join(str(i) for i in sorted(vr_of[n] for n in initial_dependencies(itf, v)))
         SubElement(ms, "InitialUnknown", {"valueReference": str(v.value_reference), "dependencies": deps})
     for sv in states:
         SubElement(ms, "InitialUnknown", {"valueReference": str(der_vr[sv.name])})

@@ -105,7 +105,7 @@ def documentation_files(itf: Interface, model_identifier: str, native: bool, fmi
     return {"documentation/index.html": index.encode(), "documentation/licenses/license.txt": licenses.encode()}
 
 
-def _zip(path: Path, files: dict[str, bytes]) -> Path:
+def write_zip(path: Path, files: dict[str, bytes]) -> Path:
     """A reproducible zip: sorted names, fixed timestamps."""
     tmp = path.with_suffix(".fmu.tmp")
     with zipfile.ZipFile(tmp, "w") as zf:
@@ -124,7 +124,7 @@ def bundled_package_name(fmu_guid: str) -> str:
     return "lcvreport_fmu_" + hashlib.sha256(fmu_guid.encode()).hexdigest()[:12]
 
 
-def _package_copy(dst: Path, name: str = "lcvreport") -> None:
+def package_copy(dst: Path, name: str = "lcvreport") -> None:
     """The lcvreport package without what an FMU does not run (caches, notebooks, sources, reports)."""
     import lcvreport
     pkg = Path(lcvreport.__file__).resolve().parent

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..analysis.batch import VariantBatch
-from ..analysis.frequency import RA_FREQUENCY_HZ, _freq, steer_to_acceleration
+from ..analysis.frequency import RA_FREQUENCY_HZ, checked_frequency, steer_to_acceleration
 from ..model.linear import check_speed, check_tire_scale, linear_model, stiffness
 from ..model.vehicle import Vehicle
 from .registry import MeasureCase
@@ -131,7 +131,7 @@ def single_sine(vehicle: Vehicle, speed_mps: float, f_hz: float = RA_FREQUENCY_H
     """
     from ..analysis.respond import respond
     from ..manoeuvres.steer import sine
-    f = float(_freq(f_hz))
+    f = float(checked_frequency(f_hz))
     steer = sine(delta0_rad, f)
     t_end = round((1.0 / f + tail_s) / step_s) * step_s
     r = respond(vehicle, model, steer, speed_mps, t_end, step_s, tire_scale, options=options)
@@ -347,9 +347,9 @@ def single_sine_peaks(batch: VariantBatch, speed_mps: float, f_hz: float | None 
     triple ``(X, XD, D)`` of the variants' rows ``y = X x + XD x' + D delta`` (shapes (B, n), (B, n),
     (B,)): a yaw-roll model's sprung-CG acceleration, the steered axle's."""
     from ..analysis.batch import RESPONSE_GROUP
-    from ..analysis.frequency import RA_FREQUENCY_HZ, _freq
+    from ..analysis.frequency import RA_FREQUENCY_HZ, checked_frequency
     from ..manoeuvres.steer import sine
-    f = float(_freq(RA_FREQUENCY_HZ if f_hz is None else f_hz))
+    f = float(checked_frequency(RA_FREQUENCY_HZ if f_hz is None else f_hz))
     steer = sine(SINGLE_SINE_DELTA0_RAD, f)
     t_end = round((1.0 / f + SINGLE_SINE_TAIL_S) / SINGLE_SINE_STEP_S) * SINGLE_SINE_STEP_S
     last = batch.vehicle.n_units - 1

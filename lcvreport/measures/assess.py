@@ -411,14 +411,14 @@ def _margin(value, bounds: tuple, absolute: bool) -> float | None:
 def _limit_text(spec, bounds: tuple, doc: dict) -> str:
     """A level's limit as a reader reads it: ``<= 0.6``, ``>= 0.15``, and a relative bound with
     its factor, the measure's value and the product (``<= 5.7 × 0.4799 = 2.736``)."""
-    from .criteria import Relative, _value
+    from .criteria import Relative, measure_value
     v = f"|{spec.key}|" if spec.absolute else ""
     parts = []
     for sign, b, num in ((">=", spec.min, bounds[0]), ("<=", spec.max, bounds[1])):
         if b is None:
             continue
         if isinstance(b, Relative):
-            ref = _value(doc, b.key)
+            ref = measure_value(doc, b.key)
             shown = "null" if ref is None else f"{ref:.4g}"
             result = "not computed" if num is None or np.isnan(num) else f"{num:.4g}"
             parts.append(f"{sign} {b.factor:g} × {b.key} = {b.factor:g} × {shown} = {result}")

@@ -133,7 +133,7 @@ def load_criteria(path: str | Path) -> Criteria:
         bounds = []
         for name, val in (("min", lo), ("max", hi)):
             if isinstance(val, str):
-                bounds.append(_relative(key, name, val))
+                bounds.append(parse_relative(key, name, val))
                 continue
             if val is not None and (isinstance(val, bool) or not isinstance(val, (int, float)) or
                                     not math.isfinite(val)):
@@ -152,7 +152,7 @@ def load_criteria(path: str | Path) -> Criteria:
     return Criteria(limits)
 
 
-def _relative(key: str, name: str, text: str) -> Relative:
+def parse_relative(key: str, name: str, text: str) -> Relative:
     m = _RELATIVE.match(text)
     if m is None:
         raise CriteriaError(f"limits.{key}.{name} must be a number or \"<factor> * <measure key>\" (e.g. "
@@ -168,7 +168,7 @@ def _relative(key: str, name: str, text: str) -> Relative:
     return Relative(factor, ref)
 
 
-def _value(doc: dict, key: str):
+def measure_value(doc: dict, key: str):
     if key.startswith("trim."):
         trim = doc.get("trim")
         return None if trim is None else trim.get(key.split(".", 1)[1])
@@ -179,7 +179,7 @@ def null_lower_bound(doc: dict, key: str) -> float | None:
     """What a null measure is known to be at least, or None: the yaw damping coefficient of a
     vehicle whose every joint is heavily damped (``yaw_damping_lower_bound``), the critical speed
     of a vehicle stable up to the search's end (200 km/h)."""
-    if _value(doc, key) is not None:
+    if measure_value(doc, key) is not None:
         return None
     return _bound(key, doc.get("yaw_damping_lower_bound"), "critical_speed_kph" in doc)
 
@@ -233,12 +233,12 @@ def judge(criteria: Criteria, doc: dict) -> dict:
     (:func:`judge_values`)."""
     out = {}
     for key, spec in criteria.limits.items():
-        value = _value(doc, key)
+        value = measure_value(doc, key)
         bound = null_lower_bound(doc, key)
-        lim = spec.resolved(lambda k: _value(doc, k))
+        lim = spec.resolved(lambda k: measure_value(doc, k))
         judged, ok = judge_values(lim, [math.nan if value is None else value],
                                   [math.nan if bound is None else bound])
-        missing = [k for k in spec.references if _value(doc, k) is None]
+        missing = [k for k in spec.references if measure_value(doc, k) is None]
         if judged[0]:
             verdict = "pass" if ok[0] else "fail"
             note = f"{spec.text()} = {lim.text()} ({lim.source})" if spec.references else f"{lim.text()} ({lim.source})"

@@ -52,7 +52,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..manoeuvres.paths import StraightArcPath
-from ..model.body import TurnError, _need_bodies, _need_tracks, corners, overall_length_m
+from ..model.body import TurnError, need_bodies, need_tracks, corners, overall_length_m
 from ..model.low_speed.kinematics import KinematicRun, KinematicsError, integrate
 from ..model.vehicle import Vehicle
 from ..util.cache import LRUCache
@@ -110,8 +110,8 @@ def check_turn_geometry(vehicle: Vehicle) -> None:
     TurnError
         Naming the unit (and axle) and the key.
     """
-    _need_bodies(vehicle)
-    _need_tracks(vehicle)
+    need_bodies(vehicle)
+    need_tracks(vehicle)
     try:
         from ..model.low_speed.kinematics import unit_geometry
         unit_geometry(vehicle)

@@ -399,9 +399,9 @@ def straight_path(vehicle: Vehicle, speed_mps: float, F=None, tire_scale: float 
     2.5908
     """
     from ..analysis.steady import reference_points
-    from ..model.body import _need_bodies
+    from ..model.body import need_bodies
     from ..model.yaw_plane.outputs import point_longitudinal, point_lateral_map
-    _need_bodies(vehicle)
+    need_bodies(vehicle)
     n = linear_model(vehicle).n_states
     tr = trim(vehicle, speed_mps, np.zeros(n) if F is None else np.asarray(F, dtype=float), tire_scale)
     check_trim(tr)

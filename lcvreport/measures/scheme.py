@@ -48,7 +48,7 @@ from pathlib import Path
 from ..ranges import RangeError
 from ..util.files import FileInputError, loads_toml, read_toml_file
 from ..util.text import control_character, listed, named, shown
-from .criteria import CriteriaError, Limit, Relative, _relative
+from .criteria import CriteriaError, Limit, Relative, parse_relative
 from .registry import CONDITIONS, CRITERIA_KEYS, MEASURES, canonical, default_condition, model_key, unknown_key_message
 
 #: the keys of a scheme file's top level
@@ -326,7 +326,7 @@ def _limit(key: str, where: str, spec, source: str | None) -> Limit:
         value = spec[b]
         if isinstance(value, str):
             try:
-                bounds[b] = _relative(key, b, value)
+                bounds[b] = parse_relative(key, b, value)
             except CriteriaError as exc:
                 raise SchemeError(f"{where}.{b}: {str(exc).split(': ', 1)[-1]}") from None
         elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):

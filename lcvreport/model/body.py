@@ -31,7 +31,7 @@ class TurnError(ValueError):
 
 def overall_length_m(vehicle: Vehicle) -> float:
     """Front of the first body to the rear of the rearmost, straight [m] (needs the body keys)."""
-    _need_bodies(vehicle)
+    need_bodies(vehicle)
     x0, lo, hi = 0.0, math.inf, -math.inf
     for k, u in enumerate(vehicle.units):
         if k > 0:
@@ -42,7 +42,7 @@ def overall_length_m(vehicle: Vehicle) -> float:
     return hi - lo
 
 
-def _need_bodies(vehicle: Vehicle) -> None:
+def need_bodies(vehicle: Vehicle) -> None:
     for k, u in enumerate(vehicle.units):
         for key in ("body_front_m", "body_rear_m", "body_width_m"):
             if getattr(u, key) is None:
@@ -50,7 +50,7 @@ def _need_bodies(vehicle: Vehicle) -> None:
                                 "unit's body_front_m, body_rear_m, body_width_m and every axle's track_width_m)")
 
 
-def _need_tracks(vehicle: Vehicle) -> None:
+def need_tracks(vehicle: Vehicle) -> None:
     for k, u in enumerate(vehicle.units):
         for j, a in enumerate(u.axles):
             if a.track_width_m is None:
@@ -119,19 +119,19 @@ def unit_poses(vehicle: Vehicle, theta: np.ndarray | None = None) -> list[tuple[
             cg, psi = np.zeros(2), 0.0
         else:
             prev_cg, prev_psi = poses[-1]
-            joint = prev_cg + vehicle.units[k - 1].rear_coupling_m * _dir(prev_psi)
+            joint = prev_cg + vehicle.units[k - 1].rear_coupling_m * direction(prev_psi)
             psi = prev_psi - theta[k - 1]
-            cg = joint - unit.front_coupling_m * _dir(psi)
+            cg = joint - unit.front_coupling_m * direction(psi)
         poses.append((cg.copy(), psi))
     return poses
 
 
-def _dir(psi: float) -> np.ndarray:
+def direction(psi: float) -> np.ndarray:
     return np.array([np.cos(psi), np.sin(psi)])
 
 
-def _rect(center: np.ndarray, psi: float, front: float, rear: float, half_width: float) -> np.ndarray:
-    d = _dir(psi)
+def body_rectangle(center: np.ndarray, psi: float, front: float, rear: float, half_width: float) -> np.ndarray:
+    d = direction(psi)
     n = np.array([-d[1], d[0]])
     return np.array([center + front * d + half_width * n, center + front * d - half_width * n,
                      center + rear * d - half_width * n, center + rear * d + half_width * n])

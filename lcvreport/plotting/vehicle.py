@@ -18,7 +18,7 @@ from matplotlib import patheffects
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
-from ..model.body import FRONT_OVERHANG_M, TRACK_WIDTH_M, _dir, _rect, body_extent, unit_kind, unit_poses
+from ..model.body import FRONT_OVERHANG_M, TRACK_WIDTH_M, direction, body_rectangle, body_extent, unit_kind, unit_poses
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.outputs import rear_offsets
 from ..model.yaw_plane.states import joint_letter
@@ -37,31 +37,31 @@ def draw_unit(ax, vehicle: Vehicle, k: int, cg: np.ndarray, psi: float, alpha: f
     front, rear, hw = body_extent(vehicle, k)
     # bodies under everything; a dolly's frame and drawbar above the trailer body that covers
     # it; every axle above all bodies (a tractor's drive axles sit under the semitrailer's front)
-    ax.add_patch(Polygon(f * _rect(cg, psi, front, rear, hw), closed=True, alpha=alpha,
+    ax.add_patch(Polygon(f * body_rectangle(cg, psi, front, rear, hw), closed=True, alpha=alpha,
                          facecolor="none" if outline_only else BODY[kind], edgecolor="black", lw=0.8,
                          zorder=1.6 if kind == "dolly" else 1.0))
     if kind == "dolly" and u.front_coupling_m > front:
-        ax.add_patch(Polygon(f * _rect(cg, psi, u.front_coupling_m, front, 0.08), closed=True, alpha=alpha,
+        ax.add_patch(Polygon(f * body_rectangle(cg, psi, u.front_coupling_m, front, 0.08), closed=True, alpha=alpha,
                              facecolor="none" if outline_only else BODY[kind], edgecolor="black", lw=0.8,
                              zorder=1.6))
     if tires:
         nrm = np.array([-np.sin(psi), np.cos(psi)])
         for a in u.axles:
-            centre = cg + a.x_m * _dir(psi)
+            centre = cg + a.x_m * direction(psi)
             per_side = max(a.tires // 2, 1)
             D = a.dual_spacing_m
             offs = [TRACK_WIDTH_M / 2] if per_side == 1 else [TRACK_WIDTH_M / 2 - D / 2 + D * j / (per_side - 1)
                                                               for j in range(per_side)]
             for side in (1, -1):
                 for o in offs:
-                    ax.add_patch(Polygon(f * _rect(centre + side * o * nrm, psi, 0.5, -0.5, 0.11), closed=True,
+                    ax.add_patch(Polygon(f * body_rectangle(centre + side * o * nrm, psi, 0.5, -0.5, 0.11), closed=True,
                                          facecolor="black", alpha=alpha, lw=0, zorder=2.5))
             a_end = centre + (TRACK_WIDTH_M / 2 + D) * nrm
             b_end = centre - (TRACK_WIDTH_M / 2 + D) * nrm
             ax.plot(f * np.array([a_end[0], b_end[0]]), f * np.array([a_end[1], b_end[1]]), color="black",
                     lw=0.8, alpha=alpha, zorder=2.5)
     if k > 0:
-        j = f * (cg + u.front_coupling_m * _dir(psi))
+        j = f * (cg + u.front_coupling_m * direction(psi))
         ax.plot(j[0], j[1], "o", ms=4, color="white", mec="black", alpha=alpha, zorder=5)
         if labels:
             ax.annotate(joint_letter(k - 1), j, xytext=(0, -12), textcoords="offset points", ha="center",
@@ -84,7 +84,7 @@ def draw_vehicle(ax, vehicle: Vehicle, theta: np.ndarray | None = None, alpha: f
     return poses
 
 
-def _top_view_axes(ax, unit: str, ylim_m: float | None = None):
+def top_view_axes(ax, unit: str, ylim_m: float | None = None):
     ax.set_aspect("equal")
     ax.set_xlabel(f"x, forward [{unit}]")
     ax.set_ylabel(f"y, toward the curb [{unit}]")
@@ -102,7 +102,7 @@ def fig_combinations(vehicles: list[tuple[str, Vehicle]], unit: str = "m") -> Fi
     for ax, (label, v) in zip(np.atleast_1d(axes), vehicles):
         draw_vehicle(ax, v, unit=unit)
         ax.set_title(label, fontsize=8, loc="left")
-        _top_view_axes(ax, unit, ylim_m=2.3)
+        top_view_axes(ax, unit, ylim_m=2.3)
     return fig
 
 
@@ -120,7 +120,7 @@ def fig_vehicle(vehicle: Vehicle, title: str) -> Figure:
                  (f"overall {length:.2f} m (bodies from the vehicle file)" if from_file else
                   f"overall about {length:.1f} m (bodies guessed: the file has no body keys; cab front assumed "
                   f"{FRONT_OVERHANG_M:.2f} m ahead of the steer axle)"), fontsize=8)
-    _top_view_axes(ax, "m", ylim_m=2.6)
+    top_view_axes(ax, "m", ylim_m=2.6)
     return fig
 
 
@@ -146,7 +146,7 @@ def fig_mode_shape(vehicle: Vehicle, modes: Modes, index: int, title: str, max_a
     ax.set_title(f"{title}: λ = {lam.real:.3f} {'+' if lam.imag >= 0 else '−'} {abs(lam.imag):.3f}i 1/s, "
                  f"f_d = {modes.damped_frequency_hz[index]:.3f} Hz, ζ = {modes.damping_ratio[index]:.3f}\n"
                  f"(phases 0/90/180/270 deg, largest articulation {max_angle_deg:g} deg)", fontsize=SMALL_PT + 0.5)
-    _top_view_axes(ax, unit)
+    top_view_axes(ax, unit)
     return fig
 
 
@@ -161,5 +161,5 @@ def fig_steady_state_top_view(vehicle: Vehicle, x_ss: np.ndarray, title: str, ex
     y = rear_offsets(vehicle, x_ss[n + 1:2 * n]) / LENGTH_UNITS[unit]
     ax.set_title(f"{title}: rear end of unit {n} offset {y[-1]:.3f} {unit} from the tractor axis "
                  f"(angles drawn x{exaggerate:g})", fontsize=8)
-    _top_view_axes(ax, unit)
+    top_view_axes(ax, unit)
     return fig

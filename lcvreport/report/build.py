@@ -34,9 +34,9 @@ from pathlib import Path
 from typing import Callable
 
 from ..units import MPS_PER_KPH
-from .notebooks import (NOTEBOOKS, PAPERS, ReportError, _execute_unchecked, execute, export_html, export_pdf, merge,
+from .notebooks import (NOTEBOOKS, PAPERS, ReportError, execute_unchecked, execute, export_html, export_pdf, merge,
                         notebook_dir)
-from .publish import (OutputFolderError, WriterLock, _discard, _folder_state, _prepare, _publish, _stage,
+from .publish import (OutputFolderError, WriterLock, discard_staged, folder_state, prepare_folder, publish_staged, stage_folder,
                       check_output_folder, write_manifest)
 from .tables import md_text
 
@@ -55,7 +55,7 @@ def build(build_dir: Path, fast: bool = False, pdf: bool = True, only: list[str]
     parameter checks) -- for tests."""
     progress = progress or (lambda _text: None)
     build_dir = Path(build_dir).resolve()
-    report_dir, data_dir = _prepare(build_dir / "report")
+    report_dir, data_dir = prepare_folder(build_dir / "report")
     nb_dir = build_dir / "notebooks"
     nb_dir.mkdir(parents=True, exist_ok=True)
     if notebook_folder is None:
@@ -72,7 +72,7 @@ def build(build_dir: Path, fast: bool = False, pdf: bool = True, only: list[str]
         stem, anchor, title = item
         t = time.perf_counter()
         path = execute(stem, nb_dir, dict(params), src) if notebook_folder is None else \
-            _execute_unchecked(stem, nb_dir, params, src)
+            execute_unchecked(stem, nb_dir, params, src)
         progress(f"notebook {stem}: {time.perf_counter() - t:.1f} s")
         return stem, anchor, title, path
 
@@ -273,8 +273,8 @@ def _one_notebook(out_dir, stem: str, params_of, title: str, intro: str, pdf: bo
 def _one_notebook_locked(out: Path, stem: str, params_of, title: str, intro: str, pdf: bool, paper: str,
                          pdf_title: str, written_by: str, progress, fast: bool, toc: bool) -> dict:
     import os
-    before = _folder_state(out)
-    staged = _stage(out)
+    before = folder_state(out)
+    staged = stage_folder(out)
     try:
         data_dir = staged / "data"
         data_dir.mkdir()
@@ -288,7 +288,7 @@ def _one_notebook_locked(out: Path, stem: str, params_of, title: str, intro: str
         written = _finish_single(staged, out, before, (stem, stem, title, path), title,
                                  intro.replace("{stamp}", stamp), pdf, pdf_title, paper, written_by, progress, toc)
     except BaseException as exc:
-        _discard(staged, isinstance(exc, KeyboardInterrupt))
+        discard_staged(staged, isinstance(exc, KeyboardInterrupt))
         raise
     res = {key: out / name for key, name in written.items()}
     res["seconds"] = time.perf_counter() - t0
@@ -308,7 +308,7 @@ def _finish_single(staged: Path, out: Path, before, part: tuple, title: str, int
         written["pdf"] = "report.pdf"
         progress("pdf written")
     write_manifest(staged, written_by)
-    _publish(staged, out, before)
+    publish_staged(staged, out, before)
     return written
 
 

@@ -475,7 +475,7 @@ def overfull_boxes(log_text: str) -> list[tuple[float, str]]:
     return sorted(out, key=lambda x: -x[0])
 
 
-def _execute_unchecked(stem, nb_dir, params, src):
+def execute_unchecked(stem, nb_dir, params, src):
     import papermill as pm
     dst = nb_dir / f"{stem}.ipynb"
     try:
@@ -488,7 +488,7 @@ def _execute_unchecked(stem, nb_dir, params, src):
     return dst
 
 
-def _alive(pid: int) -> bool:
+def process_alive(pid: int) -> bool:
     import os
     try:
         os.kill(pid, 0)
@@ -499,7 +499,7 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def _stop_kernels() -> None:
+def stop_kernels() -> None:
     """Kill the notebook kernels this process started (an interrupted report: the kernel runs
     in a session of its own, so Ctrl-C does not reach it, and it must not outlive -- or print
     into -- the folder about to be removed)."""

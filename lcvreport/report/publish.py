@@ -7,10 +7,10 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from .notebooks import ReportError, _alive, _stop_kernels, silence_client_loggers
+from .notebooks import ReportError, process_alive, stop_kernels, silence_client_loggers
 
 
-def _prepare(out_dir: Path) -> tuple[Path, Path]:
+def prepare_folder(out_dir: Path) -> tuple[Path, Path]:
     out_dir.mkdir(parents=True, exist_ok=True)
     for stale in (out_dir / "index.html", out_dir / "report.pdf", out_dir / "latex.log"):
         stale.unlink(missing_ok=True)
@@ -179,7 +179,7 @@ class WriterLock:
             self.fd = None
 
 
-def _stage(out: Path) -> Path:
+def stage_folder(out: Path) -> Path:
     """A new hidden folder beside ``out`` to write the report into: ``.<name>.writing-<pid>-XXXX``.
     Folders of that form left by a process that no longer runs (SIGKILL, a power cut) are removed
     first: they are this command's, and nobody else writes them."""
@@ -189,30 +189,30 @@ def _stage(out: Path) -> Path:
     pattern = re.compile(rf"\.{re.escape(out.name)}\.(?:writing|replaced)-(\d+)(?:-.*)?\Z")
     for p in out.parent.iterdir() if out.parent.is_dir() else ():
         m = pattern.match(p.name)
-        if m and p.is_dir() and not p.is_symlink() and not _alive(int(m.group(1))):
+        if m and p.is_dir() and not p.is_symlink() and not process_alive(int(m.group(1))):
             shutil.rmtree(p, ignore_errors=True)
     return Path(tempfile.mkdtemp(prefix=f".{out.name}.writing-{os.getpid()}-", dir=out.parent))
 
 
-def _discard(staged: Path, interrupted: bool = False) -> None:
+def discard_staged(staged: Path, interrupted: bool = False) -> None:
     """Remove a report's staging folder after a failure or an interruption: its kernels first.
     After an interruption the notebook client's event loop still waits in its own thread for the
     cell the kernel was running; the loggers it reports through are silenced first, so that the
     kernel's end is not reported as an error (the interruption is the one line)."""
     if interrupted:
         silence_client_loggers()
-    _stop_kernels()
+    stop_kernels()
     shutil.rmtree(staged, ignore_errors=True)
 
 
-def _publish(staged: Path, out: Path, existed_as: tuple) -> None:
+def publish_staged(staged: Path, out: Path, existed_as: tuple) -> None:
     """Move the finished report ``staged`` into place as ``out`` (renames on one file
     system: a reader sees the old report or the new one, never a mix).  Ctrl-C and SIGTERM wait
     while it runs (the renames and the removal of the old report are one step: an interruption
     never leaves a half-removed copy beside the new report) and take effect after it."""
     import os
     with _deferred_interrupts():
-        now = _folder_state(out)
+        now = folder_state(out)
         if now != existed_as:
             raise ReportError(f"{out} changed while the report was being written (another report into the same "
                               "folder?); nothing was replaced")
@@ -262,7 +262,7 @@ class _deferred_interrupts:
                 os.kill(os.getpid(), num)          # the default action, now
 
 
-def _folder_state(out: Path) -> tuple:
+def folder_state(out: Path) -> tuple:
     """What ``out`` is now -- absent, empty, a report (its manifest and the folder's inode: a
     report put in its place by another writer differs), or something else."""
     if not out.exists():

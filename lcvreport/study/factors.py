@@ -61,7 +61,7 @@ class Factor:
 
 
 
-def _scales(vehicle: Vehicle, factor: str, pname: str) -> bool:
+def factor_scales(vehicle: Vehicle, factor: str, pname: str) -> bool:
     """True when the factor ``factor`` scales the parameter ``pname`` (``owner.key``)."""
     if "." not in factor:
         return False
@@ -75,14 +75,14 @@ def _scales(vehicle: Vehicle, factor: str, pname: str) -> bool:
     return False
 
 
-def _value_array(f: Factor) -> np.ndarray:
+def factor_values(f: Factor) -> np.ndarray:
     """A factor's values as an array to index: numbers, or the load cases' labels."""
     if f.name == "load_units":
         return np.array([load_label(u) for u in f.values], dtype=object)
     return np.asarray(f.values, dtype=float)
 
 
-def _number(where: str, value, positive: bool = False) -> float:
+def factor_number(where: str, value, positive: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or \
             (positive and value <= 0):
         raise StudyError(f"{where} must be a finite number{' > 0' if positive else ''}, got {value!r}")
@@ -144,7 +144,7 @@ def _payload_factor(vehicle: Vehicle, name: str, spec) -> Factor:
     place = {}
     for key, value in placement.items():
         from ..ranges import VEHICLE
-        x = _number(f"{where}.{key}", value)
+        x = factor_number(f"{where}.{key}", value)
         if key == "x_m":
             VEHICLE["position_m"].check(x, f"{where}.x_m")
         elif key == "height_m":
@@ -157,7 +157,7 @@ def _payload_factor(vehicle: Vehicle, name: str, spec) -> Factor:
     if not has_static_loads(vehicle):
         missing = next(a.name for a in vehicle.axles if a.static_load_N is None)
         raise StudyError(f"{where}: a payload moves the static axle loads, and axle {missing} has no static_load_N")
-    f = _factor_values(where, rest, lambda k, v: RANGES["payload"].check(_number(f"{where}.{k}", v), f"{where}.{k}"))
+    f = _factor_values(where, rest, lambda k, v: RANGES["payload"].check(factor_number(f"{where}.{k}", v), f"{where}.{k}"))
     return replace(f, name=name, **place)
 
 
@@ -179,12 +179,12 @@ def _factor_values(where: str, spec: dict, number) -> Factor:
             raise StudyError(f"{where}: low must be below high, got low {lo:g}, high {hi:g}")
         return Factor("", distribution="uniform", low=lo, high=hi)
     if dist == "normal":
-        mean, sd = number("mean", spec.get("mean")), _number(f"{where}.sd", spec.get("sd"), True)
+        mean, sd = number("mean", spec.get("mean")), factor_number(f"{where}.sd", spec.get("sd"), True)
         return Factor("", distribution="normal", mean=mean, sd=sd)
     raise StudyError(f"{where}.distribution must be uniform or normal (or give values = [...]), got {dist!r}")
 
 
-def _factor(vehicle: Vehicle, name: str, spec) -> Factor:
+def parse_factor(vehicle: Vehicle, name: str, spec) -> Factor:
     where = f"factors.{name}"
     if name == "load_units":
         return _load_units_factor(vehicle, where, spec)
@@ -219,7 +219,7 @@ def _factor(vehicle: Vehicle, name: str, spec) -> Factor:
     positive = not signed                      # scales and speeds > 0; residual sources any sign, in range
 
     def number(key, value):
-        x = _number(f"{where}.{key}", value, positive)
+        x = factor_number(f"{where}.{key}", value, positive)
         if signed:
             RANGES[signed].check(x, f"{where}.{key}")
         return x

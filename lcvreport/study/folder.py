@@ -24,7 +24,7 @@ def chunk_name(k: int) -> str:
     return f"chunk-{k:06d}.parquet"
 
 
-def _json(path: Path) -> dict:
+def read_folder_json(path: Path) -> dict:
     """A JSON document of a study folder (through the guarded reader: a FIFO never blocks)."""
     from ..util.files import read_text_file
     try:

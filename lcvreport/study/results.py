@@ -21,14 +21,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .folder import CHUNKS, MANIFEST, STUDY, _json, chunk_name
+from .folder import CHUNKS, MANIFEST, STUDY, read_folder_json, chunk_name
 from .spec import StudyError, study_from_stored
 
 
 def _manifest(folder: Path) -> dict:
     if not (folder / MANIFEST).exists():
         raise StudyError(f"{folder} holds no study results ({MANIFEST} is missing)")
-    return _json(folder / MANIFEST)
+    return read_folder_json(folder / MANIFEST)
 
 
 def _checked(folder: Path) -> tuple[dict, object]:
@@ -127,7 +127,7 @@ def stored_study(folder):
     """The :class:`~lcvreport.study.spec.Study` whose results are in ``folder`` (as it was run)."""
     folder = Path(folder)
     _manifest(folder)
-    return study_from_stored(_json(folder / STUDY))
+    return study_from_stored(read_folder_json(folder / STUDY))
 
 
 def study_case(folder, case_id: int):

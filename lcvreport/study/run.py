@@ -176,9 +176,9 @@ def _prepare(study: Study, out: Path) -> Path:
         manifest = out / MANIFEST
         if not manifest.is_file():
             raise StudyError(f"--out {out} holds files that are not a study's results; give a new or empty folder")
-        from .folder import _json
+        from .folder import read_folder_json
         try:
-            old = _json(manifest)
+            old = read_folder_json(manifest)
         except StudyError:
             raise StudyError(f"--out {out}: its {MANIFEST} cannot be read; give a new or empty folder") from None
         if old.get("format") != FORMAT or old.get("study_sha256") != digest:

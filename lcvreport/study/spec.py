@@ -56,7 +56,7 @@ from ..model.vehicle_file import dumps_vehicle, load_vehicle, loads_vehicle
 from ..ranges import RANGES, RangeError
 from ..units import kph_to_mps
 from .factors import (AXLE_SCALES, PAYLOAD, PLAIN_FACTORS, RESIDUALS, ROLL_PARAMETERS, UNIT_SCALES,  # noqa: F401
-                      Factor, StudyError, _factor, _number, _scales, _value_array, load_label, residual_axle,
+                      Factor, StudyError, parse_factor, factor_number, factor_scales, factor_values, load_label, residual_axle,
                       residual_key)
 
 #: measures computed batched over the cases (lcvreport.analysis.batch, the registry's BATCHED groups);
@@ -158,7 +158,7 @@ class Study:
         n = min(DRAW_BLOCK, self.count - block * DRAW_BLOCK)
         rng = np.random.default_rng([self.seed, factor_index, block])
         if f.values:
-            return _value_array(f)[rng.integers(0, len(f.values), n)]
+            return factor_values(f)[rng.integers(0, len(f.values), n)]
         if f.distribution == "uniform":
             return rng.uniform(f.low, f.high, n)
         return rng.normal(f.mean, f.sd, n)
@@ -233,7 +233,7 @@ class Study:
                 bad = np.flatnonzero(~(ok & (vals <= r.high) & np.isfinite(vals)))
                 if bad.size:
                     k = int(bad[0])
-                    used = [f.name for f in self.factors if f.name in table and _scales(self.vehicle, f.name, pname)]
+                    used = [f.name for f in self.factors if f.name in table and factor_scales(self.vehicle, f.name, pname)]
                     given = ", ".join(f"{f} = {float(table[f][k]):.6g}" for f in used)
                     raise StudyError(f"factors.{used[0] if used else pname}: case {int(ids[k])} makes {pname} "
                                      f"{vals[k]:.6g} {r.unit} ({given}); {key} must be in {r.text()}")
@@ -304,7 +304,7 @@ class Study:
         out = {}
         rest = ids.copy()
         for f, n in zip(reversed(self.factors), reversed(sizes)):
-            out[f.name] = _value_array(f)[rest % n]
+            out[f.name] = factor_values(f)[rest % n]
             rest //= n
         return {f.name: out[f.name] for f in self.factors}
 
@@ -489,14 +489,14 @@ def study_from_dict(doc: dict, base: Path | None = None) -> Study:
         raise StudyError("factors: at least one factor is needed (a table of factor = {values = [...]} or "
                          "{distribution = ...})")
     try:
-        factors = tuple(_factor(vehicle, n, s) for n, s in factors_doc.items())
+        factors = tuple(parse_factor(vehicle, n, s) for n, s in factors_doc.items())
     except RangeError as exc:
         raise StudyError(str(exc.args[0] if exc.args else exc)) from None
     if "speed_kph" in factors_doc and "speed_mps" in factors_doc:
         raise StudyError("factors: give speed_kph or speed_mps, not both")
     speed_kph = None
     if "speed_kph" not in factors_doc and "speed_mps" not in factors_doc:
-        speed_kph = _number("speed_kph", doc.get("speed_kph"), positive=True) if "speed_kph" in doc else None
+        speed_kph = factor_number("speed_kph", doc.get("speed_kph"), positive=True) if "speed_kph" in doc else None
         if speed_kph is None:
             raise StudyError("speed_kph: give the speed (speed_kph = 88.0) or a speed factor")
     count, seed = 0, None

@@ -9,11 +9,11 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import FancyArrowPatch
 
-from ..model.body import _dir, body_extent, unit_poses
+from ..model.body import direction, body_extent, unit_poses
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.states import joint_letter
 from ..plotting.style import LENGTH_UNITS, PAGE_WIDTH_IN, PALETTE, SMALL_PT, new_figure
-from ..plotting.vehicle import _top_view_axes, draw_unit, draw_vehicle
+from ..plotting.vehicle import top_view_axes, draw_unit, draw_vehicle
 
 
 def fig_load_configuration(vehicle: Vehicle, configuration: str, title: str, fraction: float = 0.01,
@@ -31,7 +31,7 @@ def fig_load_configuration(vehicle: Vehicle, configuration: str, title: str, fra
     axles = {a.name: a for a in vehicle.axles}
     for t in forces:
         cg, psi = poses[where[t.axle]]
-        d = _dir(psi)
+        d = direction(psi)
         nrm = np.array([-d[1], d[0]])
         start = cg + axles[t.axle].x_m * d + t.lateral_offset_m * nrm
         end = start + np.sign(t.force_N) * (0.45 + 0.75 * abs(t.force_N) / fmax) * nrm
@@ -39,7 +39,7 @@ def fig_load_configuration(vehicle: Vehicle, configuration: str, title: str, fra
         ax.add_patch(FancyArrowPatch(f * start, f * end, arrowstyle="-|>", mutation_scale=7, color="red",
                                      alpha=1.0 if configuration == "balanced" or changed else 0.25, lw=1.0))
     ax.set_title(f"{title} ({100 * fraction:g} % of each tire load along y)", fontsize=8)
-    _top_view_axes(ax, unit, ylim_m=2.8)
+    top_view_axes(ax, unit, ylim_m=2.8)
     return fig
 
 
@@ -100,7 +100,7 @@ def fig_free_body(vehicle: Vehicle, title: str, unit: str = "in") -> Figure:
                                              mutation_scale=7, color="green"))
                 ax.annotate(f"F{joint_letter(k)}", f * (p + (0, 2.05)), ha="center", va="top",
                             fontsize=SMALL_PT, color="green")
-        _top_view_axes(ax, unit, ylim_m=2.6)
+        top_view_axes(ax, unit, ylim_m=2.6)
         f_unit = 1.0 / LENGTH_UNITS[unit]
         ax.set_ylim(2.7 * f_unit, -4.1 * f_unit)
     axes[0].set_title(title, fontsize=8)
