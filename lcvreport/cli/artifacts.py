@@ -8,7 +8,8 @@ from pathlib import Path
 
 
 from ..ranges import RangeError
-from .options import UsageError, load_units_of, sources_of, speed_mps_of, vehicle_of
+from .options import (Command, UsageError, add_load, add_residuals, add_source, add_speed, load_units_of,
+                      model_choices, sources_of, speed_mps_of, vehicle_of)
 from .output import OutputError, Output
 
 
@@ -217,3 +218,65 @@ def _checked(option: str, check, value, error) -> None:
         check(value)
     except error as exc:
         raise UsageError(f"argument {option}: {exc}") from None
+
+
+# ---------------------------------------------------------------------------- options
+def fmu_options(sp) -> None:
+    from ..model.base import MODELS
+    add_source(sp, masses=False)
+    sp.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    sp.add_argument("--kind", default=None, choices=("python", "native", "both"),
+                    help="python (pythonfmu, pythonfmu3 for FMI 3.0), native (C99) or both (default both)")
+    sp.add_argument("--fmi", default="2", choices=("2", "3"),
+                    help="FMI version (default 2): <name>.fmu and <name>Native.fmu, or <name>3.fmu and "
+                         "<name>Native3.fmu")
+    sp.add_argument("--model", default="yaw-plane", choices=model_choices(MODELS),
+                    help="the model built in (default yaw-plane); yaw-roll adds the roll states and the "
+                         "sprung accelerations, load transfers and LTRs as outputs, and needs the vehicle's roll "
+                         "keys (docs/roll.md); nonlinear: the nonlinear planar model (docs/nonlinear.md), its "
+                         "Python FMI 2.0 Co-Simulation FMU <name>_nonlinear.fmu only")
+    add_speed(sp, required=False)
+
+
+def report_options(sp) -> None:
+    add_source(sp, masses=False)
+    add_speed(sp, required=False)
+    add_load(sp, False, convention=False)
+    add_residuals(sp)
+    sp.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    sp.add_argument("--no-pdf", action="store_true", help="HTML only")
+    sp.add_argument("--paper", default="letter", choices=("letter", "a4"), help="paper of the PDF (default letter)")
+    sp.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
+    sp.add_argument("--tracking-stats", metavar="SPEC",
+                    help="a tire population for the straight-line tracking chapter: conicity=DIST,ply_steer=DIST,"
+                         "mounting=out|in|random[,conicity_moment=DIST,ply_steer_moment=DIST,draws=N,seed=S,"
+                         "lane_width_m=W,body_width_m=B], DIST = normal:MEAN:SD | uniform:LO:HI [N, N*m]")
+
+
+def study_options(sp) -> None:
+    sp.add_argument("study_file", metavar="STUDY.toml", help="the study file")
+    sp.add_argument("--out", required=True, metavar="DIR", help="results folder: new, empty, or this study's "
+                                                               "earlier results (then only missing chunks run)")
+    where = sp.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, metavar="N", help="a local Dask cluster of N worker processes")
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="an existing Dask scheduler (tcp://host:8786). Connect only to a cluster you trust: "
+                            "Dask's messages carry pickles, so a scheduler runs what it likes in this process")
+    sp.add_argument("--csv", action="store_true", help="also write DIR/results.csv (one row per case)")
+    sp.add_argument("--report", metavar="REPORT_DIR", help="then write the study report (HTML, PDF) into REPORT_DIR: "
+                                                           "new, empty or an earlier report")
+    sp.add_argument("--criteria", metavar="FILE", help="with --report: limits to judge the cases by (TOML)")
+    sp.add_argument("--scheme", metavar="FILE", help="assess every case against a scheme file (docs/assessment.md): "
+                                                     "the level each measure and the case reach as columns, and in "
+                                                     "the report the share of cases reaching each level")
+    sp.add_argument("--no-pdf", action="store_true", help="with --report: HTML only")
+    sp.add_argument("--json", action="store_true", help="machine-readable summary")
+
+
+COMMANDS = {
+    "fmu": Command("FMUs of the vehicle (FMI 2.0 or 3.0; native: Co-Simulation and Model Exchange)", fmu_options,
+                   cmd_fmu),
+    "report": Command("assessment report of the vehicle (HTML and PDF)", report_options, cmd_report),
+    "study": Command("a study file's cases (factors, design, measures) in batches on Dask, results in Parquet",
+                     study_options, cmd_study),
+}

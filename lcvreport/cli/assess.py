@@ -2,7 +2,8 @@
 verdict table, the level each measure reaches and the vehicle's (docs/assessment.md)."""
 from __future__ import annotations
 
-from .options import UsageError, one_line, load_units_of, sources_of, vehicle_of
+from .options import (Command, UsageError, add_load, add_source, add_tire_scale, help_range, load_units_of, one_line,
+                      sources_of, vehicle_of)
 from .output import Output
 
 
@@ -111,3 +112,29 @@ def verdict_lines(a) -> list[str]:
     lines.append("  (n/c: not computed, the reason above; limits, margins and sources: lcv assess --json, or the "
                  "report)")
     return lines
+
+
+def assess_options(sp) -> None:
+    add_source(sp)
+    sp.add_argument("--scheme", required=True, metavar="FILE",
+                    help="the scheme file (TOML): levels, and per measure its conditions and limits per level, "
+                         "each with its source (examples/schemes/)")
+    add_tire_scale(sp)
+    add_load(sp, False, convention=False)
+    sp.add_argument("--residual", action="append", default=[], metavar="AXLE=P,T",
+                    help="residual force P [N] (+y) and moment T [N*m] (+z) on an axle, a source of the trim and "
+                         "the straight path; repeatable (the crossfall is the scheme's crossfall_percent)")
+    sp.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
+                    help=f"thrust angle of an axle [rad], in {help_range('misalignment')}; repeatable or "
+                         f"comma-separated")
+    sp.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML): their axle P and T")
+    sp.add_argument("--out", metavar="DIR", help="also write the assessment report (HTML, PDF; the verdict table "
+                                                 "first, then the evidence of every measure): new, empty or an "
+                                                 "earlier report")
+    sp.add_argument("--no-pdf", action="store_true", help="with --out: HTML only")
+    sp.add_argument("--paper", default="letter", choices=("letter", "a4"), help="paper of the PDF (default letter)")
+    sp.add_argument("--json", action="store_true", help="machine-readable output (docs/assessment.md)")
+
+
+COMMANDS = {"assess": Command("a performance-based standards assessment: every measure of a scheme file at its own "
+                              "conditions, judged per level (docs/assessment.md)", assess_options, cmd_assess)}

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from ..measures.registry import MEASURES
 from ..units import mps_to_kph
-from .options import UsageError, one_line, load_units_of, parse_speeds, sources_of, vehicle_of
+from .options import (Command, UsageError, add_conditions, add_load, add_residuals, add_source, add_tire_scale,
+                      load_units_of, model_choices, one_line, parse_speeds, sources_of, vehicle_of)
 from .output import check_finite, Output
 
 
@@ -145,3 +146,26 @@ def _groups(vehicle) -> int:
 
 def _flat_columns(doc: dict, vehicle) -> list[str]:
     return list(_flatten(doc, vehicle))
+
+
+def measures_options(sp) -> None:
+    from ..model.base import MODELS
+    add_source(sp)
+    g = sp.add_mutually_exclusive_group(required=True)
+    g.add_argument("--speed-kph", metavar="V", help="forward speed [km/h], or a sweep START:STOP:STEP")
+    g.add_argument("--speed-mph", metavar="V", help="forward speed [mph], or a sweep START:STOP:STEP")
+    add_tire_scale(sp)
+    add_load(sp, False, convention=False)
+    add_residuals(sp)
+    add_conditions(sp)
+    sp.add_argument("--criteria", metavar="FILE", help="limits to judge the measures by (TOML, see examples/)")
+    sp.add_argument("--model", default="yaw-plane", choices=model_choices(MODELS),
+                    help="the model of the manoeuvres' and eigenvalues' measures (their keys are the same on every "
+                         "model: hsto_m of the yaw-roll model is the default's hsto_m_roll); nonlinear: its "
+                         "responses, its linearization's eigenvalues and its friction demand (docs/model.md)")
+    sp.add_argument("--json", action="store_true", help="machine-readable output")
+
+
+COMMANDS = {"measures": Command("the measures: damping, RA, YDC, HSTO, HSSO, trim, the low-speed turn, roll (SRT, "
+                                "LTR, roll gains; with roll data) (defined in docs/measures.md)", measures_options,
+                                cmd_measures)}

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..model.linear import linear_model
 from ..units import SI, THESIS
-from .options import load_vector_of, speed_mps_of, speed_text, vehicle_of
+from .options import Command, add_common, load_vector_of, model_choices, speed_mps_of, speed_text, vehicle_of
 from .output import check_finite, Output
 
 
@@ -95,3 +95,29 @@ def cmd_steady(args, out: Output) -> int:
     for name, value in ydoc.items():
         out.line(f"  {name:7s} {value: .6e} m")
     return 0
+
+
+# ---------------------------------------------------------------------------- options
+def eig_options(sp) -> None:
+    from ..model.base import LINEAR_MODELS
+    add_common(sp, None)
+    sp.add_argument("--model", default="yaw-plane", choices=model_choices(LINEAR_MODELS),
+                    help="the model: yaw-plane (default) or yaw-roll (the vehicle's roll keys, docs/roll.md)")
+
+
+def matrices_options(sp) -> None:
+    add_common(sp, False)
+    sp.add_argument("--units", choices=("thesis", "si"), default=None,
+                    help="unit system of the matrices (default: thesis for presets, si for vehicle files)")
+
+
+def presets_options(sp) -> None:
+    sp.add_argument("--json", action="store_true")
+
+
+COMMANDS = {
+    "eig": Command("eigenvalues [1/s], damped frequency, damping ratio", eig_options, cmd_eig),
+    "matrices": Command("M, S (and F with --load)", matrices_options, cmd_matrices),
+    "steady": Command("steady state under the 1 %% rule loads, SI units", lambda sp: add_common(sp, True), cmd_steady),
+    "presets": Command("list the presets", presets_options, cmd_presets),
+}

@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -233,3 +235,104 @@ def one_line(text) -> str:
         return line
     kept = MESSAGE_CHARS - 40                       # room for the mark, whatever the count
     return line[:kept] + f" ... ({len(line) - kept} characters more)"
+
+
+# ---------------------------------------------------------------------------- the parser
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (:class:`UsageError`, exit 2), no usage dump."""
+
+    def error(self, message: str) -> None:
+        raise UsageError(message)
+
+
+@dataclass(frozen=True)
+class Command:
+    """One ``lcv`` command: its help line, what adds its options to its parser, what runs it
+    (``run(args, out) -> exit status``).  Each command module lists its own in ``COMMANDS``."""
+
+    help: str
+    options: Callable[[argparse.ArgumentParser], None]
+    run: Callable
+
+
+def add_source(sp: argparse.ArgumentParser, masses: bool = True) -> None:
+    """``--preset NAME | --vehicle FILE`` (and a preset's ``--masses``)."""
+    from ..model.presets import MASS_OPTIONS, PRESETS
+    g = sp.add_mutually_exclusive_group(required=True)
+    g.add_argument("--preset", metavar="NAME", help=f"vehicle preset: {', '.join(PRESETS)}")
+    g.add_argument("--vehicle", metavar="FILE", help="vehicle file (TOML, SI; see the README)")
+    if masses:
+        sp.add_argument("--masses", default="table", choices=MASS_OPTIONS,
+                        help="presets: table (printed, rounded) or unrounded (implied by the published "
+                             "matrices; aucnat and tractor_semitrailer)")
+
+
+def add_speed(sp: argparse.ArgumentParser, required: bool = True) -> None:
+    """``--speed-kph V | --speed-mph V``, checked against the speed range."""
+    g = sp.add_mutually_exclusive_group(required=required)
+    g.add_argument("--speed-kph", type=ranged("speed", 1 / MPS_PER_KPH, "km/h", "forward speed in km/h"),
+                   metavar="V", help=f"forward speed [km/h], in {help_range('speed', 1 / MPS_PER_KPH, 'km/h')}")
+    g.add_argument("--speed-mph", type=ranged("speed", 1 / MPS_PER_MPH, "mph", "forward speed in mph"),
+                   metavar="V", help=f"forward speed [mph], in {help_range('speed', 1 / MPS_PER_MPH, 'mph')}")
+
+
+def add_tire_scale(sp: argparse.ArgumentParser) -> None:
+    """``--tire-scale S``."""
+    sp.add_argument("--tire-scale", default=1.0, type=ranged("tire_scale", what="factor on the tire coefficients"),
+                    metavar="S", help=f"factor on every tire coefficient (chapter V), in {help_range('tire_scale')}; "
+                                      "default 1")
+
+
+def add_load(sp: argparse.ArgumentParser, required: bool, convention: bool = True) -> None:
+    """``--load UNITS`` (the 1 % rule) and its ``--convention``."""
+    from ..model.yaw_plane.loads import CONVENTIONS
+    sp.add_argument("--load", required=required, metavar="UNITS",
+                    help="comma list of units carrying the 1 %% rule (unit names of the vehicle)")
+    if convention:
+        sp.add_argument("--convention", default="consistent", choices=CONVENTIONS,
+                        help="load-vector convention (default consistent)")
+
+
+def add_common(sp: argparse.ArgumentParser, load_required: bool | None) -> None:
+    """The vehicle, the speed, the tire scale, ``--load`` (unless None) and ``--json``."""
+    add_source(sp)
+    add_speed(sp)
+    add_tire_scale(sp)
+    if load_required is not None:
+        add_load(sp, load_required)
+    sp.add_argument("--json", action="store_true", help="machine-readable output")
+
+
+def add_residuals(sp: argparse.ArgumentParser) -> None:
+    """The residual sources: ``--residual``, ``--misalignment``, ``--crossfall-percent``, ``--tires``."""
+    sp.add_argument("--residual", action="append", default=[], metavar="AXLE=P,T",
+                    help="residual force P [N] (+y) and moment T [N*m] (+z) on an axle; repeatable")
+    sp.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
+                    help=f"thrust angle of an axle [rad], nose-right positive, in "
+                         f"{help_range('misalignment')}; repeatable or comma-separated")
+    sp.add_argument("--crossfall-percent", type=ranged("crossfall", what="road crossfall in %"), metavar="C",
+                    help=f"road crossfall [%%], positive falling toward +y, in {help_range('crossfall')}")
+    sp.add_argument("--tires", metavar="FILE", help="mounted tires (CSV or TOML: position, conicity_N, "
+                                                     "ply_steer_N, serial_side[, moments]): their axle P and T")
+
+
+def add_conditions(sp: argparse.ArgumentParser) -> None:
+    """One option per condition of the registry (but the speed and the crossfall)."""
+    from ..measures.registry import CONDITIONS
+    for c in CONDITIONS.values():
+        if c.key in ("speed_kph", "crossfall_percent"):
+            continue
+        if c.choices:                          # a choice (the RA reference points), not a number
+            sp.add_argument(c.option, dest=c.key, choices=c.choices,
+                            help=c.definition.replace("%", "%%") + (f"; default {c.default}" if c.default else ""))
+            continue
+        sp.add_argument(c.option, dest=c.key, type=ranged(c.range, unit=c.unit, what=c.label), metavar="X",
+                        help=c.definition.replace("%", "%%") + f" [{c.unit}], in "
+                             f"{help_range(c.range, unit=c.unit)}; default {c.default:g}")
+
+
+def model_choices(models) -> tuple[str, ...]:
+    """The command line's spelling (``yaw-plane``) of the models ``models`` (keys of
+    :data:`lcvreport.model.base.MODELS`): what ``--model`` offers, from the registry of models."""
+    from ..model.base import CLI_NAMES
+    return tuple(CLI_NAMES[m] for m in models)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from .options import UsageError, one_line, plot_path_of, speed_mps_of, vehicle_of
+from .options import Command, UsageError, add_common, one_line, plot_path_of, speed_mps_of, vehicle_of
 from .output import Output, write_figure_new
 
 
@@ -61,3 +61,13 @@ def cmd_roll(args, out: Output) -> int:
     if plot is not None:
         out.line(f"wrote {plot}")
     return 0
+
+
+def roll_options(sp) -> None:
+    add_common(sp, None)
+    sp.add_argument("--plot", metavar="FILE", help="write the a_y - phi curve of every group, each lift-off marked "
+                                                   "(.png, .pdf or .svg; a new file)")
+
+
+COMMANDS = {"roll": Command("roll: static rollover threshold per roll-coupled group (lift-off axle by axle), roll "
+                            "gains, load transfer ratios, roll modes (docs/roll.md)", roll_options, cmd_roll)}

@@ -9,7 +9,8 @@ import numpy as np
 from ..model.base import MODELS, check_model
 from ..model.linear import linear_model
 from ..ranges import RANGES, RangeError
-from .options import UsageError, one_line, one_percent_vector_of, sources_of, speed_mps_of, vehicle_of
+from .options import (Command, UsageError, add_common, add_residuals, help_range, model_choices, one_line,
+                      one_percent_vector_of, ranged, sources_of, speed_mps_of, vehicle_of)
 from .output import check_finite, Output
 
 
@@ -124,3 +125,28 @@ def _simulate_nonlinear(args, out: Output, v, steer, steps: int) -> int:
     row_format = ",".join(["%.10g"] * M.shape[1]) + "\n"
     out.write("".join([row_format % tuple(row) for row in M.tolist()]))
     return 0
+
+
+def simulate_options(sp) -> None:
+    add_common(sp, False)
+    add_residuals(sp)
+    sp.add_argument("--steer", metavar="SPEC", default=None,
+                    help="steer input: step:A, sine:A:F, pulse:A:D, csv:FILE, lane-change:A0:F (A0 in m/s^2 or "
+                         "with g, e.g. 0.15g), driver:A0:F[:K:T] (that path driven in closed loop by a preview "
+                         "driver, gain K rad/m, preview T s); default none")
+    sp.add_argument("--t-end", default=10.0, type=ranged("t_end", what="end time in s"), metavar="T",
+                    help=f"end time [s], in {help_range('t_end')}; default 10")
+    sp.add_argument("--tire", choices=("saturating", "linear"), default=None,
+                    help="the nonlinear model's tire law (default saturating: the brush tire)")
+    sp.add_argument("--friction-coefficient", type=ranged("friction", what="friction coefficient mu"),
+                    metavar="MU", default=None, help="the nonlinear model's mu, in (0, 2]; default 0.8")
+    sp.add_argument("--model", default="yaw-plane", choices=model_choices(MODELS),
+                    help="the model: yaw-plane (default), yaw-roll (adds roll rates, roll angles, sprung CG "
+                         "accelerations, axle load transfers and load transfer ratios; needs the roll keys) or "
+                         "nonlinear (docs/nonlinear.md)")
+    sp.add_argument("--dt", default=0.01, type=ranged("output_step", what="output step in s"), metavar="H",
+                    help=f"output step [s], in {help_range('output_step')}; must divide t-end; default 0.01")
+
+
+COMMANDS = {"simulate": Command("exact response from rest to a steer input and residual sources, streamed as CSV "
+                                "(or JSON), SI units", simulate_options, cmd_simulate)}

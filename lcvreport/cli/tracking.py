@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import math
 
-from .options import UsageError, source_force_of, speed_mps_of, speed_text, vehicle_of
+from .options import (Command, Parser, UsageError, add_source, add_speed, add_tire_scale, help_range, ranged,
+                      source_force_of, speed_mps_of, speed_text, vehicle_of)
 from .output import Output
 
 
@@ -97,3 +98,51 @@ def cmd_tracking(args, out: Output) -> int:
     out.line(f"  P(|offtracking| > {s.margin_m:.4g} m) = {s.exceedance_probability:.6g}  (95 % CI {lo:.3g} .. "
              f"{hi:.3g}, Monte Carlo)")
     return 0
+
+
+# ---------------------------------------------------------------------------- options
+def tracking_options(trk) -> None:
+    tsub = trk.add_subparsers(dest="tracking_command", metavar="WHAT", parser_class=Parser)
+    tsub.required = True
+    st = tsub.add_parser("stats", help="offtracking over a tire population: exact mean and SD, Monte Carlo lane "
+                                       "exceedance")
+    add_source(st, masses=False)
+    add_speed(st)
+    add_tire_scale(st)
+    for opt, what in (("--conicity", "conicity force per tire [N]"), ("--ply-steer", "ply steer force per tire [N]"),
+                      ("--conicity-moment", "conicity moment per tire [N*m]"),
+                      ("--ply-steer-moment", "ply steer moment per tire [N*m]")):
+        st.add_argument(opt, metavar="DIST", required=opt in ("--conicity", "--ply-steer"),
+                        help=f"{what}: normal:MEAN:SD or uniform:LO:HI")
+    st.add_argument("--mounting", required=True, choices=("out", "in", "random"), help="serial side of every tire")
+    st.add_argument("--axles", metavar="A,B,...", help="axles whose tires are drawn (default: units 2..N)")
+    st.add_argument("--lane-width-m", type=float, default=3.66, metavar="W", help="lane width [m] (3.66)")
+    st.add_argument("--body-width-m", type=float, default=2.59, metavar="B", help="body width [m] (2.59)")
+    st.add_argument("--draws", type=int, default=1_000_000, metavar="N", help="Monte Carlo draws (1e6)")
+    st.add_argument("--seed", type=int, default=20110801, metavar="S", help="random seed (printed)")
+    _road(st)
+    st.add_argument("--json", action="store_true", help="machine-readable output")
+    pl = tsub.add_parser("place", help="mounting plan of measured tires with the least trimmed offtracking "
+                                       "(exact, a mixed-integer program)")
+    add_source(pl, masses=False)
+    add_speed(pl)
+    add_tire_scale(pl)
+    pl.add_argument("--tires", dest="measured_tires", required=True, metavar="TIRES.csv",
+                    help="measured tires: CSV id,conicity_N,ply_steer_N[,conicity_moment_Nm,ply_steer_moment_Nm]")
+    pl.add_argument("--positions", metavar="POS,POS,...",
+                    help="positions to fill, axle:slot (default: every tire position of units 2..N)")
+    _road(pl)
+    pl.add_argument("--draws", type=int, default=10_000, metavar="N", help="random placements to compare (1e4)")
+    pl.add_argument("--seed", type=int, default=20110801, metavar="S", help="seed of the random placements")
+    pl.add_argument("--json", action="store_true", help="machine-readable output")
+
+
+def _road(sp) -> None:
+    sp.add_argument("--crossfall-percent", type=ranged("crossfall", what="road crossfall in %"), metavar="C",
+                    help=f"road crossfall [%%], in {help_range('crossfall')}")
+    sp.add_argument("--misalignment", action="append", default=[], metavar="AXLE=RAD",
+                    help="thrust angle of an axle [rad]; repeatable or comma-separated")
+
+
+COMMANDS = {"tracking": Command("straight-line tracking: per-tire conicity and ply steer", tracking_options,
+                                cmd_tracking)}

@@ -1,7 +1,8 @@
 """``lcv turn``: the low-speed turn and its measures, with the swept-path figure."""
 from __future__ import annotations
 
-from .options import UsageError, one_line, plot_path_of, vehicle_of
+from .options import (Command, UsageError, add_source, help_range, model_choices, one_line, plot_path_of, ranged,
+                      vehicle_of)
 from .output import Output, write_figure_new
 
 
@@ -83,3 +84,31 @@ def _turn_nonlinear(args, out: Output, v, plot) -> int:
     if plot is not None:
         out.line(f"wrote {plot}")
     return 0
+
+
+def turn_options(sp) -> None:
+    from ..model.base import NONLINEAR_MODELS
+    add_source(sp, masses=False)
+    sp.add_argument("--radius", type=ranged("turn_radius", what="outside steer wheel radius in m"), default=12.5,
+                    metavar="R", help=f"radius of the outside steer wheel's path [m], in "
+                                      f"{help_range('turn_radius')}; default 12.5")
+    sp.add_argument("--angle-deg", type=ranged("turn_angle", what="turn angle in deg"), default=90.0, metavar="A",
+                    help=f"angle of the turn [deg], in {help_range('turn_angle')}; default 90")
+    sp.add_argument("--plot", metavar="FILE", help="draw the swept path into FILE (.png, .pdf or .svg; a new file)")
+    sp.add_argument("--model", default="kinematic", choices=("kinematic",) + model_choices(NONLINEAR_MODELS),
+                    help="the kinematic model (default: no forces) or the nonlinear model with tire forces "
+                         "(friction demand, docs/nonlinear.md)")
+    sp.add_argument("--speed-kph", type=ranged("speed", factor=3.6, unit="km/h", what="turn speed in km/h"),
+                    default=None, metavar="V", help="with --model nonlinear: unit 1's speed [km/h]; default 5")
+    sp.add_argument("--friction-coefficient", type=ranged("friction", what="friction coefficient mu"),
+                    metavar="MU", default=None, help="with --model nonlinear: mu, in (0, 2]; default 0.8")
+    sp.add_argument("--path-gain", type=ranged("path_gain", what="path gain in rad/m"), metavar="K",
+                    default=None, help="with --model nonlinear: the path-following law's gain [rad/m]; default 2 "
+                                       "(and its integral term, docs/nonlinear.md)")
+    sp.add_argument("--tire", choices=("saturating", "linear"), default=None,
+                    help="with --model nonlinear: the tire law; default saturating")
+    sp.add_argument("--json", action="store_true", help="machine-readable output")
+
+
+COMMANDS = {"turn": Command("low-speed turn (90 deg by default): swept width, offtracking, tail and frontal swing "
+                            "(kinematic model, docs/low_speed_turn.md)", turn_options, cmd_turn)}

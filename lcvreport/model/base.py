@@ -46,6 +46,8 @@ MODELS = {"yaw_plane": "yaw_plane.equations:system_coefficients",
           "nonlinear": "nonlinear.model:nonlinear_model"}
 #: the linear ones (exact responses, eigenvalues, frequency responses)
 LINEAR_MODELS = ("yaw_plane", "yaw_roll")
+#: the others (integrated; any angle: the low-speed turn with tire forces)
+NONLINEAR_MODELS = tuple(m for m in MODELS if m not in LINEAR_MODELS)
 #: the spelling of the command line (``--model yaw-plane``) of each model
 CLI_NAMES = {name: name.replace("_", "-") for name in MODELS}
 
