@@ -81,6 +81,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``rollover``         the static rollover threshold: quasi-static, lift-off axle by axle, exact events
     ``roll``             the roll measures: LTR, roll gains, the yaw-roll model's RA, HSTO, damping
     ``ra_points``        rearward amplification's numerator and denominator points (sprung CG, roll axis, steer axle)
+    ``case``             one case: vehicle, model, speed, tire scale, conditions, load case, sources (Case)
     ``measure_set``      every measure of a vehicle at a speed (MeasureSet)
     ``criteria``         the user's limits and the verdicts
     ``scheme``           scheme files: levels, and per measure its conditions and limits per level
@@ -194,6 +195,7 @@ _API = {
     "place_tires": "tracking.placement", "build_fmus": "fmu.build:build_vehicle_fmus",
     "build_report": "report.build:build_assessment", "build_model": "model.base", "respond": "analysis.respond",
     "integrate": "analysis.integrate", "nonlinear_model": "model.nonlinear.model",
+    "Case": "measures.case",
 }
 __all__ = sorted(_API) + ["ranges", "units"]
 

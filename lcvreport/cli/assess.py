@@ -2,8 +2,7 @@
 verdict table, the level each measure reaches and the vehicle's (docs/assessment.md)."""
 from __future__ import annotations
 
-from .options import (Command, UsageError, add_load, add_source, add_tire_scale, help_range, load_units_of, one_line,
-                      sources_of, vehicle_of)
+from .options import Command, UsageError, add_load, add_source, add_tire_scale, case_of, help_range, one_line
 from .output import Output
 
 
@@ -30,13 +29,11 @@ def assessment_of(args):
     (their names and SHA-256)."""
     from pathlib import Path
 
-    from ..measures.assess import assess
     from ..model.presets import preset_path
-    v = vehicle_of(args)
+    case = case_of(args, speed=False)       # the scheme gives each measure's speed and conditions
+    v = case.vehicle
     scheme = load_scheme_option(args.scheme)
-    units = load_units_of(args, v) if args.load is not None else None
-    sources = sources_of(args, v)
-    a = assess(v, scheme, args.tire_scale, units, sources if sources else None)
+    a = case.assess(scheme)
     vehicle = (Path(args.vehicle).name, _file_bytes(args.vehicle, "vehicle file")) if args.vehicle is not None \
         else (f"preset {args.preset}", preset_path(args.preset).read_bytes())
     return v, scheme, a.with_files(vehicle, (Path(args.scheme).name, _file_bytes(args.scheme, "scheme file")))

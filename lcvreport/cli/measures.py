@@ -3,46 +3,35 @@
 """
 from __future__ import annotations
 
-
-
 from ..measures.registry import MEASURES
 from ..units import mps_to_kph
 from .options import (Command, UsageError, add_conditions, add_load, add_residuals, add_source, add_tire_scale,
-                      load_units_of, model_choices, one_line, parse_speeds, sources_of, vehicle_of)
+                      case_of, model_choices, one_line, parse_speeds, vehicle_of)
 from .output import check_finite, Output
 
 
 def cmd_measures(args, out: Output) -> int:
     from ..measures.criteria import CriteriaError, judge, load_criteria
-    from ..measures.measure_set import measure_set
     v = vehicle_of(args)
     speeds, unit = parse_speeds(args)
-    units = load_units_of(args, v) if args.load is not None else None
-    sources = sources_of(args, v)
+    case = case_of(args, v, speed=False)        # every option checked once, before any measure is computed
     criteria = None
     if args.criteria is not None:
         try:
             criteria = load_criteria(args.criteria)
         except CriteriaError as exc:
             raise UsageError(f"argument --criteria {args.criteria}: {exc}") from None
-    from ..measures.registry import CONDITIONS
-    conditions = {k: getattr(args, k) for k in CONDITIONS if k not in ("speed_kph", "ra_frequency_hz",
-                                                                       "crossfall_percent")
-                  and getattr(args, k, None) is not None}
-    f_hz = args.ra_frequency_hz if args.ra_frequency_hz is not None else CONDITIONS["ra_frequency_hz"].default
-    model = getattr(args, "model", "yaw-plane").replace("-", "_")
+    model = case.model
     if model != "yaw_plane":                    # the model's keys checked before any measure is computed
-        from ..model.base import build_model
         from ..model.vehicle import VehicleError
         try:
-            build_model(v, model)
+            case.model_object()
         except (VehicleError, ValueError) as exc:
             raise UsageError(f"argument --model {args.model}: {one_line(exc)}") from None
     docs, sets = [], []
     for u in speeds:
         try:
-            m = measure_set(v, u, args.tire_scale, units, f_hz=f_hz, sources=sources if sources else None,
-                            conditions=conditions, model=model)
+            m = case.replace(speed_mps=u).measure_set()
         except ValueError as exc:
             if "static_load_N" in str(exc):
                 raise UsageError(f"argument --load: {exc}") from None

@@ -7,7 +7,8 @@ import numpy as np
 
 from ..model.linear import linear_model
 from ..units import SI, THESIS
-from .options import Command, add_common, load_vector_of, model_choices, speed_mps_of, speed_text, vehicle_of
+from .options import (Command, add_common, case_of, load_vector_of, model_choices, speed_mps_of, speed_text,
+                      vehicle_of)
 from .output import check_finite, Output
 
 
@@ -28,10 +29,11 @@ def cmd_eig(args, out: Output) -> int:
     model = check_model(args.model)
     if model == "yaw_roll":
         from .roll import roll_vehicle
-        v = roll_vehicle(args)                    # the roll keys, checked: one line naming what is missing
+        case = case_of(args, roll_vehicle(args))   # the roll keys, checked: one line naming what is missing
     else:
-        v = vehicle_of(args)
-    m = modes(v, speed_mps_of(args), args.tire_scale, model=model)
+        case = case_of(args)
+    v = case.vehicle
+    m = modes(v, case.speed_mps, case.tire_scale, model=case.model)
     check_finite(m.eigenvalues)
     k = m.least_damped
     if args.json:

@@ -336,3 +336,30 @@ def model_choices(models) -> tuple[str, ...]:
     :data:`lcvreport.model.base.MODELS`): what ``--model`` offers, from the registry of models."""
     from ..model.base import CLI_NAMES
     return tuple(CLI_NAMES[m] for m in models)
+
+
+# ---------------------------------------------------------------------------- the case
+def case_of(args: argparse.Namespace, vehicle=None, speed: bool = True):
+    """The :class:`~lcvreport.measures.case.Case` of the options, built once: the vehicle (given,
+    or ``--preset``/``--vehicle``), the speed (unless ``speed`` is False: a sweep, an assessment),
+    ``--tire-scale``, ``--model``, the registry's condition options, ``--load``, the residual
+    sources and the model's ``--tire``.  A value the case refuses: one line naming the option (exit 2)."""
+    from ..measures.case import Case
+    from ..measures.registry import CONDITIONS
+    from ..model.base import ModelError
+    from ..ranges import RangeError
+    v = vehicle if vehicle is not None else vehicle_of(args)
+    given = getattr(args, "speed_kph", None) is not None or getattr(args, "speed_mph", None) is not None
+    units = load_units_of(args, v) if getattr(args, "load", None) is not None else ()
+    sources = sources_of(args, v)
+    conditions = {k: getattr(args, k) for k in CONDITIONS
+                  if k not in ("speed_kph", "crossfall_percent") and getattr(args, k, None) is not None}
+    options = {"tire": args.tire} if getattr(args, "tire", None) is not None else {}
+    model = getattr(args, "model", None) or "yaw-plane"
+    try:
+        return Case(v, speed_mps_of(args) if speed and given else None, getattr(args, "tire_scale", 1.0), model,
+                    conditions, units, sources if sources else None, options)
+    except ModelError as exc:
+        raise UsageError(f"argument --model: {exc}") from None
+    except (KeyError, RangeError, ValueError) as exc:
+        raise UsageError(f"argument: {exc.args[0] if exc.args else exc}") from None

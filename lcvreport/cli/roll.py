@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from .options import Command, UsageError, add_common, one_line, plot_path_of, speed_mps_of, vehicle_of
+from .options import Command, UsageError, add_common, case_of, one_line, plot_path_of, vehicle_of
 from .output import Output, write_figure_new
 
 
@@ -26,9 +26,10 @@ def roll_vehicle(args):
 
 def cmd_roll(args, out: Output) -> int:
     from ..measures.roll import roll_summary, unstable_at_rest_note
-    v = roll_vehicle(args)
+    case = case_of(args, roll_vehicle(args))
+    v = case.vehicle
     plot = plot_path_of(args)
-    s = roll_summary(v, speed_mps_of(args), args.tire_scale)
+    s = roll_summary(v, case.speed_mps, case.tire_scale)
     if plot is not None:
         write_figure_new(s.plot(), plot)
     if args.json:

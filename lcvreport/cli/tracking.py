@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import math
 
-from .options import (Command, Parser, UsageError, add_source, add_speed, add_tire_scale, help_range, ranged,
-                      source_force_of, speed_mps_of, speed_text, vehicle_of)
+from .options import (Command, Parser, UsageError, add_source, add_speed, add_tire_scale, case_of, help_range,
+                      ranged, speed_text, vehicle_of)
 from .output import Output
 
 
@@ -38,9 +38,10 @@ def _cmd_place(args, out: Output) -> int:
     except TrackingError as exc:
         raise UsageError(f"argument --tires: {exc}") from None
     positions = [p.strip() for p in args.positions.split(",")] if args.positions else None
-    F = source_force_of(args, v)
+    case = case_of(args, v)
+    F = case.force()
     try:
-        pl = place_tires(v, speed_mps_of(args), tires, positions, F, args.tire_scale, args.draws, args.seed)
+        pl = place_tires(v, case.speed_mps, tires, positions, F, case.tire_scale, args.draws, args.seed)
     except TrackingError as exc:
         opt = "--positions" if str(exc).startswith("position") else "--tires"
         raise UsageError(f"argument {opt}: {exc}") from None
@@ -80,11 +81,12 @@ def cmd_tracking(args, out: Output) -> int:
         if not (math.isfinite(val) and 0 < val <= 10):
             raise UsageError(f"argument {opt}: must be in (0, 10] m, got {val:g}")
     axles = [a.strip() for a in args.axles.split(",")] if args.axles else None
-    F = source_force_of(args, v)
+    case = case_of(args, v)
+    F = case.force()
     try:
-        s = tracking_stats(v, speed_mps_of(args), dists["conicity"], dists["ply_steer"], args.mounting,
+        s = tracking_stats(v, case.speed_mps, dists["conicity"], dists["ply_steer"], args.mounting,
                            dists["conicity_moment"], dists["ply_steer_moment"], axles, args.lane_width_m,
-                           args.body_width_m, args.draws, args.seed, F, args.tire_scale)
+                           args.body_width_m, args.draws, args.seed, F, case.tire_scale)
     except TrackingError as exc:
         opt = " --axles" if "axle" in str(exc).split(";")[0] and args.axles else ""
         raise UsageError(f"argument{opt}: {exc}") from None

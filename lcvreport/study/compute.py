@@ -22,7 +22,6 @@ import numpy as np
 
 from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ
-from ..measures.measure_set import measure_values
 from ..measures.registry import BATCHED as BATCH_GROUPS
 from ..measures.registry import FAMILIES, MeasureCase
 from ..model.linear import linear_model
@@ -77,8 +76,7 @@ def compute_chunk(study: Study, case_ids) -> dict:
     rest = [m for m in study.measures if m not in batched]
     if rest:
         for k, case_id in enumerate(ids):
-            vehicle, speed_mps, kwargs = study.case(int(case_id))
-            values = measure_values(vehicle, speed_mps, rest, **kwargs)     # their families only
+            values = study.case_object(int(case_id)).measure_values(rest)   # their families only
             for m in rest:
                 value = values.get(m)
                 cols[m][k] = np.nan if value is None else float(value)
@@ -89,16 +87,14 @@ def scheme_columns(study: Study, ids: np.ndarray) -> dict:
     """The assessment of every case against the study's scheme (docs/studies.md#schemes):
     ``scheme.<key>`` each scheme measure's value at its conditions (NaN: not computed),
     ``level.<key>`` the level it reaches and ``level_reached`` the case's ("" for none), each
-    case as :func:`lcvreport.measures.assess.assess` of its vehicle (one case at a time)."""
-    from ..measures.assess import assess
+    case as :meth:`~lcvreport.measures.case.Case.assess` of its case (one case at a time)."""
     scheme = study.scheme
     keys = [m.key for m in scheme.measures]
     cols = {f"scheme.{k}": np.full(ids.size, np.nan) for k in keys}
     levels = {f"level.{k}": [] for k in keys}
     reached = []
     for k, case_id in enumerate(ids):
-        vehicle, _speed, kwargs = study.case(int(case_id))
-        a = assess(vehicle, scheme, kwargs.get("tire_scale", 1.0), kwargs.get("load_units"), kwargs.get("sources"))
+        a = study.case_object(int(case_id)).assess(scheme)
         for m in a.measures:
             cols[f"scheme.{m.key}"][k] = np.nan if m.value is None else float(m.value)
             levels[f"level.{m.key}"].append(m.level_reached or "")

@@ -380,6 +380,26 @@ class Study:
             kwargs["sources"] = sources
         return self.case_vehicle(self.batch_parameters(table), 0, table), float(self.speeds_mps(table)[0]), kwargs
 
+    def case_object(self, case_id: int):
+        """The :class:`~lcvreport.measures.case.Case` of one case (its vehicle, speed -- None where the
+        study has none --, tire scale, load case and residual sources): what its row is computed from.
+
+        Examples
+        --------
+        >>> from lcvreport.study.spec import study_from_dict
+        >>> s = study_from_dict({"vehicle": "tractor_semitrailer", "speed_kph": 88.0, "measures": ["hsso_m"],
+        ...     "factors": {"trailer1.mass_scale": {"values": [0.8, 1.2]}}})
+        >>> c = s.case_object(1)
+        >>> round(c.speed_mps * 3.6, 6), c.vehicle.units[1].mass_kg > s.vehicle.units[1].mass_kg
+        (88.0, True)
+        """
+        import math
+
+        from ..measures.case import Case
+        vehicle, speed_mps, kwargs = self.case(case_id)
+        return Case(vehicle, None if math.isnan(speed_mps) else speed_mps, kwargs.get("tire_scale", 1.0),
+                    load_units=tuple(kwargs.get("load_units") or ()), sources=kwargs.get("sources"))
+
     def case_vehicle(self, params: dict, k: int, table: dict | None = None) -> Vehicle:
         """The vehicle of row ``k`` of the scaled parameters ``params`` (:meth:`batch_parameters`,
         without payloads) and, with the factor ``table``, its payloads: every scaled parameter
