@@ -127,7 +127,8 @@ def batched_roll(vehicle, count: int = 128) -> None:
     roll_batched(warm, SPEED_MPS), rollover_batched(warm), measure_values(variant(0), SPEED_MPS, list(keys))
     t = time.perf_counter()
     batch = VariantBatch.of_vehicles(vehicle, [variant(i) for i in range(count)], "yaw_roll")
-    got = np.column_stack(roll_batched(batch, SPEED_MPS) + rollover_batched(batch))
+    both = {**roll_batched(batch, SPEED_MPS), **rollover_batched(batch)}
+    got = np.column_stack([both[key] for key in keys])
     t_batch = time.perf_counter() - t
     some = range(0, count, 8)
     t = time.perf_counter()

@@ -224,7 +224,8 @@ def test_batched_lane_change_is_the_one_variant_lane_change(preset, speed):
     rng = np.random.default_rng(11)
     B = 66
     values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, B) for n in names}
-    hsto, ra = lane_change_batched(VariantBatch(v, values), speed)
+    lc = lane_change_batched(VariantBatch(v, values), speed)
+    hsto, ra = lc["hsto_m"], lc["ra_lane_change"]
     for i in (0, 5, 63, 64, 65):
         ref = lane_change_measures(_variant(v, values, i), speed)
         assert hsto[i] == pytest.approx(ref.hsto_m, rel=1e-12, abs=1e-12), i
@@ -239,11 +240,12 @@ def test_a_variant_with_an_unstable_inverse_system_has_no_lane_change():
     v = load_preset("legal_max")
     name = f"{v.units[0].name}.yaw_inertia_kg_m2"
     values = {name: _nominal(v, name) * np.array([1.0, 1.0])}
-    hsto, ra = lane_change_batched(VariantBatch(v, values), 60.0)
+    lc = lane_change_batched(VariantBatch(v, values), 60.0)
+    hsto, ra = lc["hsto_m"], lc["ra_lane_change"]
     with pytest.raises(ManoeuvreError, match="unstable"):
         lane_change_measures(v, 60.0)
     assert np.isnan(hsto).all() and np.isnan(ra).all()
-    hsto, _ra = lane_change_batched(VariantBatch(v, values), 20.0)
+    hsto = lane_change_batched(VariantBatch(v, values), 20.0)["hsto_m"]
     assert np.isfinite(hsto).all()
 
 

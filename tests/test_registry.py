@@ -76,8 +76,8 @@ def test_every_batched_family_equals_its_scalar_one_for_a_batch_of_one():
                 continue
             values, _ = f.compute(case)
             arrays = f.compute_batched(batch, bcase)
-            assert len(arrays) == len(f.batched_keys), f.name
-            for key, arr in zip(f.batched_keys, arrays):
+            assert list(arrays) == list(f.batched_keys), f.name
+            for key, arr in arrays.items():
                 want = values[key]
                 if want is None:
                     assert np.isnan(arr[0]), (f.name, key)
@@ -162,3 +162,40 @@ def test_no_steered_axle_gives_every_steer_measure_its_reason():
         if f.needs == "steer":
             for k in f.keys:
                 assert m.value(k) is None and "no steered axle" in m.reason(k), k
+
+
+def test_families_give_mappings_a_new_key_shifts_nothing(monkeypatch):
+    """Issue 41 item 5: a family's batched values are a mapping by key.  A key added to the lane
+    change's batched function reaches no other key (the roll family reads the lane change by name,
+    not by position), and a batched function whose tuple no longer matches its family's keys is
+    refused, never read shifted."""
+    import functools
+
+    import numpy as np
+
+    from lcvreport.analysis.batch import VariantBatch
+    from lcvreport.measures import offtracking, roll
+    from lcvreport.measures.registry import FAMILIES, MeasureCase
+    from lcvreport.model.vehicle_file import load_vehicle
+
+    from conftest import EXAMPLES
+    v = load_vehicle(EXAMPLES / "b_double.toml")
+    b = VariantBatch(v, {"rear_trailer.mass_kg": v.units[-1].mass_kg * np.array([0.9, 1.0])})
+    before = roll.roll_batched(b, 25.0)
+    real = offtracking.lane_change_batched
+
+    @functools.wraps(real)
+    def with_a_new_key(*args, **kwargs):
+        out = real(*args, **kwargs)
+        return {"final_offset_m": np.zeros(2), **out}            # a key added first: positions all move
+    monkeypatch.setattr(offtracking, "lane_change_batched", with_a_new_key)
+    after = roll.roll_batched(b, 25.0)
+    assert list(after) == list(before)
+    for key in before:
+        np.testing.assert_array_equal(after[key], before[key])
+    case = MeasureCase(v, 25.0, 1.0, 0.4)
+    got = FAMILIES["lane_change"].compute_batched(b, case)
+    assert list(got) == ["hsto_m", "ra_lane_change"]
+    monkeypatch.setattr(offtracking, "lane_change_batched", lambda *a, **k: (np.zeros(2),) * 3)
+    with pytest.raises(TypeError, match="gives 3 arrays for 2 keys"):
+        FAMILIES["lane_change"].compute_batched(b, case)

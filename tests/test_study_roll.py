@@ -64,8 +64,8 @@ def test_roll_measures_batched_over_cg_heights_equal_each_variant():
     variants = [replace(v, units=tuple(replace(u, cg_height_m=u.cg_height_m * s) if i >= 1 else u
                                        for i, u in enumerate(v.units))) for s in (0.9, 1.0, 1.15)]
     batch = VariantBatch.of_vehicles(v, variants, "yaw_roll")
-    got = dict(zip(FAMILIES["roll"].batched_keys, roll_batched(batch, 24.0)))
-    got.update(zip(FAMILIES["rollover"].batched_keys, rollover_batched(batch)))
+    got = {**roll_batched(batch, 24.0), **rollover_batched(batch)}
+    assert list(got) == list(FAMILIES["roll"].batched_keys + FAMILIES["rollover"].batched_keys)
     assert set(got) == {"roll_least_damping_ratio", "roll_critical_speed_kph", "ra_single_sine_roll",
                         "ra_lane_change_roll", "hsto_m_roll", "rltr_lane_change", "srt_rrcu_g", "srt_min_g"}
     for k, variant in enumerate(variants):

@@ -347,6 +347,6 @@ def batch_measures(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.
     case = MeasureCase(batch.vehicle, float(speed_mps), float(tire_scale), float(f_hz), F)
     for family in FAMILIES.values():
         if family.batched and family.applies(case):
-            for key, arr in zip(family.batched_keys, family.compute_batched(batch, case)):
+            for key, arr in family.compute_batched(batch, case).items():
                 table[key] = np.asarray(arr, dtype=float)
     return table

@@ -237,17 +237,17 @@ def steady_turn(vehicle: Vehicle, speed_mps: float, tire_scale: float = 1.0,
 
 def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0,
                         lane_change_ay_g: float | None = None,
-                        lane_change_frequency_hz: float | None = None, extra=None) -> tuple:
-    """(HSTO [m], the lane change's RA [-]) of every variant, as
+                        lane_change_frequency_hz: float | None = None, extra: dict | None = None) -> dict:
+    """``{"hsto_m": HSTO [m], "ra_lane_change": the lane change's RA [-]}`` of every variant, as
     :func:`lcvreport.measures.offtracking.lane_change_measures` (the path-following lane
     change through each variant's inverse system, on the batch's model): the last unit's rearmost
     axle's largest overshoot beyond the steered axle's final offset (0 if none), and max|a_N| /
     max|a_s|.  NaN where the inverse system is unstable or does not exist, or the steer leaves
     [-1, 1] rad (measure_set's null).  ``lane_change_ay_g`` [g] and ``lane_change_frequency_hz``
-    [Hz]: A0 and F (default :data:`LANE_CHANGE`).  ``extra``: a list of triples ``(X, XD, D)``, each
+    [Hz]: A0 and F (default :data:`LANE_CHANGE`).  ``extra``: ``{name: (X, XD, D)}``, each
     variant's row of one more signal ``y = X x + XD x' + D delta`` (shapes (B, n), (B, n), (B,)),
-    whose peaks |y| are then returned after the two (the yaw-roll model's load transfer ratio, its
-    sprung CG's acceleration, a reference point of RA)."""
+    whose peaks |y| are then returned under ``name`` beside the two (the yaw-roll model's load
+    transfer ratio, its sprung CG's acceleration, a reference point of RA)."""
     from ..analysis.exact import steered_point
     from ..manoeuvres.steer import G_MPS2, lane_change, lane_change_offset_m
     v = batch.vehicle
@@ -272,7 +272,7 @@ def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
             C[:, 2] = Mz[:, 0] + xs * Mz[:, 1]                              # a_s = v1' + x_s r1' + u r1
             C[:, 2, 1] += u
             C[:, 3] = d_row                                                 # the steer (within [-1, 1] rad)
-            for k, rows_k in enumerate(extra or ()):                       # X x + XD x' + D delta
+            for k, rows_k in enumerate((extra or {}).values()):            # X x + XD x' + D delta
                 X, XD, D = (np.asarray(a)[rows] for a in rows_k)
                 C[:, 4 + k, :n] = X
                 C[:, 4 + k] += np.einsum("bn,bnd->bd", XD, Mz[:, :n])
@@ -294,7 +294,7 @@ def lane_change_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
         hsto[rows[steer_ok]] = np.maximum(0.0, over[steer_ok])
         ra[rows[steer_ok]] = peak[steer_ok, 1] / peak[steer_ok, 2]
         peak_extra[rows[steer_ok]] = peak[steer_ok, 4:]
-    return (hsto, ra) if extra is None else (hsto, ra, *peak_extra.T)
+    return {"hsto_m": hsto, "ra_lane_change": ra, **dict(zip(extra or {}, peak_extra.T))}
 
 
 def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float = 1.0,

@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+from collections.abc import Mapping
 from importlib import resources
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -205,15 +206,28 @@ class Family:
             return {k: None for k in self.keys}, ({"trim": why} if self.needs == "sources" else
                                                   {k: why for k in self.keys})
 
-    def compute_batched(self, batch, case: MeasureCase) -> tuple:
-        """One array (B,) per key of :attr:`batched_keys`, NaN where undefined."""
+    def compute_batched(self, batch, case: MeasureCase) -> dict:
+        """``{key: array (B,)}`` for every key of :attr:`batched_keys`, NaN where undefined.  The
+        batched function returns a mapping by key (a positional tuple is read against
+        :attr:`batched_keys` only when its length is theirs: a key added to the family and not to
+        the function is refused, never a column shifted onto another key)."""
         fn = _resolve(self.batched)
         names = inspect.signature(fn).parameters
         kwargs = {k: getattr(case, k) for k in ("speed_mps", "tire_scale", "f_hz", "F") if k in names}
         kwargs.update({k: case.condition(k) for k in self.conditions if k in names and not CONDITIONS[k].choices})
         kwargs.update({k: case.conditions.get(k) for k in self.conditions if k in names and CONDITIONS[k].choices})
         out = fn(batch, **kwargs)
-        return out if isinstance(out, tuple) else (out,)
+        keys = self.batched_keys
+        if isinstance(out, Mapping):
+            missing = [k for k in keys if k not in out]
+            if missing:
+                raise TypeError(f"family {self.name}: its batched function {self.batched} gives no {', '.join(missing)}")
+            return {k: out[k] for k in keys}
+        out = out if isinstance(out, tuple) else (out,)
+        if len(out) != len(keys):
+            raise TypeError(f"family {self.name}: its batched function {self.batched} gives {len(out)} arrays for "
+                            f"{len(keys)} keys ({', '.join(keys)}); return a mapping by key")
+        return dict(zip(keys, out))
 
 
 @dataclass(frozen=True, eq=False)

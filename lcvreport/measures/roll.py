@@ -198,9 +198,14 @@ def _dynamic(vehicle: Vehicle, u: float, s: float, f_hz: float = LANE_CHANGE[1],
     return values, reasons
 
 
+#: the keys :func:`roll_batched` gives (the registry's roll family's batched keys)
+BATCHED_KEYS = ("roll_least_damping_ratio", "roll_critical_speed_kph", "ra_single_sine_roll", "ra_lane_change_roll",
+                "hsto_m_roll", "rltr_lane_change")
+
+
 def roll_batched(batch, speed_mps: float, tire_scale: float = 1.0, f_hz: float = LANE_CHANGE[1],
                  lane_change_ay_g: float = LANE_CHANGE[0], lane_change_frequency_hz: float = LANE_CHANGE[1],
-                 ra_numerator: str | None = None, ra_denominator: str | None = None) -> tuple:
+                 ra_numerator: str | None = None, ra_denominator: str | None = None) -> dict:
     """The roll family's scalar measures over the variants of ``batch`` (any model: its variants
     are taken to the yaw-roll model, each one's coefficients built exactly), one array each in the
     registry's order: ``roll_least_damping_ratio``, ``roll_critical_speed_kph``,
@@ -216,22 +221,23 @@ def roll_batched(batch, speed_mps: float, tire_scale: float = 1.0, f_hz: float =
     >>> from lcvreport.analysis.batch import VariantBatch
     >>> v = load_vehicle("examples/vehicles/b_double.toml")
     >>> b = VariantBatch(v, {"rear_trailer.mass_kg": v.units[-1].mass_kg * np.array([0.9, 1.0])})
-    >>> zeta, crit, ra_ss, ra_lc, hsto, rltr = roll_batched(b, 25.0)
-    >>> bool(abs(rltr[1] - roll_summary(v, 25.0).ltr_lane_change[-1]) < 1e-12)
+    >>> got = roll_batched(b, 25.0)
+    >>> bool(abs(got["rltr_lane_change"][1] - roll_summary(v, 25.0).ltr_lane_change[-1]) < 1e-12)
     True
     """
     from .amplification import single_sine_peaks
     from .offtracking import lane_change_batched
     from .stability import critical_speed_batched, least_damping_batched
     if missing_roll_data(batch.vehicle) is not None:
-        return tuple(np.full(batch.size, np.nan) for _ in range(6))
+        return {key: np.full(batch.size, np.nan) for key in BATCHED_KEYS}
     rb = batch.on_model(MODEL)
     u, s = float(speed_mps), float(tire_scale)
     zeta = least_damping_batched(rb, u, s)[0]
     crit = critical_speed_batched(rb, s)
     nan = np.full(rb.size, np.nan)
     if not rb.vehicle.steered_axles:
-        return zeta, crit, nan, nan, nan, nan.copy()
+        return {"roll_least_damping_ratio": zeta, "roll_critical_speed_kph": crit,
+                **{key: nan.copy() for key in BATCHED_KEYS[2:]}}
     unstable = np.array([unstable_at_rest(v) is not None for v in rb.vehicles()])
     co = linear_model(rb.vehicle, MODEL)
     nu = rb.vehicle.n_units
@@ -258,22 +264,23 @@ def roll_batched(batch, speed_mps: float, tire_scale: float = 1.0, f_hz: float =
     num_lc, den_lc = ra_points(ra_numerator, ra_denominator, "ra_lane_change_roll")
     ss = dict(zip(names, single_sine_peaks(rb, u, f_hz, s, extra=points)[:, 4:].T))
     ra_ss = ss[num_ss] / ss[den_ss]
-    hsto, _ra, rltr, *peaks = lane_change_batched(rb, u, s, lane_change_ay_g, lane_change_frequency_hz,
-                                                  extra=[stack(ltr_rows), *points])
-    lc = dict(zip(names, peaks))
+    lc = lane_change_batched(rb, u, s, lane_change_ay_g, lane_change_frequency_hz,
+                             extra={"rltr": stack(ltr_rows), **dict(zip(names, points))})
     ra_lc = lc[num_lc] / lc[den_lc]
-    responses = [np.where(unstable, np.nan, a) for a in (ra_ss, ra_lc, hsto, rltr)]   # as roll_family: undefined
-    return (zeta, crit, *responses)
+    responses = {key: np.where(unstable, np.nan, a)                                   # as roll_family: undefined
+                 for key, a in (("ra_single_sine_roll", ra_ss), ("ra_lane_change_roll", ra_lc),
+                                ("hsto_m_roll", lc["hsto_m"]), ("rltr_lane_change", lc["rltr"]))}
+    return {"roll_least_damping_ratio": zeta, "roll_critical_speed_kph": crit, **responses}
 
 
-def rollover_batched(batch) -> tuple:
+def rollover_batched(batch) -> dict:
     """``srt_rrcu_g`` and ``srt_min_g`` [g] of every variant of ``batch`` (:func:`rollover_family`
     variant by variant: the threshold's events are exact, one short search per variant); NaN
     without roll data."""
     if missing_roll_data(batch.vehicle) is not None:
-        return np.full(batch.size, np.nan), np.full(batch.size, np.nan)
+        return {"srt_rrcu_g": np.full(batch.size, np.nan), "srt_min_g": np.full(batch.size, np.nan)}
     out = np.array([[t.srt_rrcu_g, t.srt_min_g] for t in map(rollover_threshold, batch.vehicles())], dtype=float)
-    return out[:, 0], out[:, 1]
+    return {"srt_rrcu_g": out[:, 0], "srt_min_g": out[:, 1]}
 
 
 def _no_roll(keys, vehicle: Vehicle):

@@ -68,7 +68,7 @@ def compute_chunk(study: Study, case_ids) -> dict:
                         v, [study.case_vehicle(params, int(k), table) for k in rows], model)
                 case = MeasureCase(v, float(u), float(ts), RA_FREQUENCY_HZ, None if F is None else F[rows])
                 arrays = FAMILIES[group].compute_batched(batches[model], case)
-                for name, arr in zip(BATCH_GROUPS[group], arrays):
+                for name, arr in arrays.items():
                     if name in batched:
                         cols[name][rows] = np.broadcast_to(arr, rows.shape)
     if study.scheme_toml is not None:
