@@ -222,7 +222,7 @@ def _checked(option: str, check, value, error) -> None:
 
 # ---------------------------------------------------------------------------- options
 def fmu_options(sp) -> None:
-    from ..model.base import MODELS
+    from ..fmu.interface import FMU_MODELS
     add_source(sp, masses=False)
     sp.add_argument("--out", required=True, metavar="DIR", help="output folder")
     sp.add_argument("--kind", default=None, choices=("python", "native", "both"),
@@ -230,7 +230,7 @@ def fmu_options(sp) -> None:
     sp.add_argument("--fmi", default="2", choices=("2", "3"),
                     help="FMI version (default 2): <name>.fmu and <name>Native.fmu, or <name>3.fmu and "
                          "<name>Native3.fmu")
-    sp.add_argument("--model", default="yaw-plane", choices=model_choices(MODELS),
+    sp.add_argument("--model", default="yaw-plane", choices=model_choices(FMU_MODELS),
                     help="the model built in (default yaw-plane); yaw-roll adds the roll states and the "
                          "sprung accelerations, load transfers and LTRs as outputs, and needs the vehicle's roll "
                          "keys (docs/roll.md); nonlinear: the nonlinear planar model (docs/nonlinear.md), its "

@@ -334,8 +334,7 @@ def add_conditions(sp: argparse.ArgumentParser) -> None:
 def model_choices(models) -> tuple[str, ...]:
     """The command line's spelling (``yaw-plane``) of the models ``models`` (keys of
     :data:`lcvreport.model.base.MODELS`): what ``--model`` offers, from the registry of models."""
-    from ..model.base import CLI_NAMES
-    return tuple(CLI_NAMES[m] for m in models)
+    return tuple(m.replace("_", "-") for m in models)         # a model registered after import too
 
 
 # ---------------------------------------------------------------------------- the case

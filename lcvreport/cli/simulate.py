@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ..model.base import MODELS, check_model
+from ..model.base import LINEAR_MODELS, MODELS, check_model
 from ..model.linear import linear_model
 from ..ranges import RANGES, RangeError
 from .options import (Command, UsageError, add_common, add_residuals, help_range, model_choices, one_line,
@@ -39,8 +39,8 @@ def cmd_simulate(args, out: Output) -> int:
     if model == "yaw_roll":
         from .roll import roll_vehicle
         roll_vehicle(args)                      # the roll keys, checked: one line naming what is missing
-    if model == "nonlinear":
-        return _simulate_nonlinear(args, out, v, steer, steps)
+    if model not in LINEAR_MODELS:                # integrated: the nonlinear model, or any model MODELS names
+        return _simulate_integrated(args, out, v, steer, steps, model)
     if args.tire is not None or args.friction_coefficient is not None:
         raise UsageError("arguments --tire/--friction-coefficient: the nonlinear model's (--model nonlinear)")
     axle_force = np.zeros(len(v.axles))
@@ -90,19 +90,24 @@ def cmd_simulate(args, out: Output) -> int:
     return 0
 
 
-def _simulate_nonlinear(args, out: Output, v, steer, steps: int) -> int:
-    """``lcv simulate --model nonlinear``: the nonlinear model integrated (docs/nonlinear.md), the
-    columns of its outputs; a lane change of the inverse system is a linear model's (refused)."""
+def _simulate_integrated(args, out: Output, v, steer, steps: int, model: str) -> int:
+    """``lcv simulate --model nonlinear`` (or any model of MODELS that is not linear): the model
+    integrated (docs/nonlinear.md), the columns of its outputs; a lane change of the inverse system
+    is a linear model's (refused)."""
     from ..analysis.integrate import IntegrationError, integrate
     from ..model.base import build_model
     from ..model.vehicle import VehicleError
     if args.load is not None:
         raise UsageError("argument --load: the 1 %% rule is a linear model's load case; give --residual AXLE=P,T")
     try:
-        m = build_model(v, "nonlinear", tire=args.tire or "saturating",
-                        friction_coefficient=0.8 if args.friction_coefficient is None else args.friction_coefficient)
-    except (VehicleError, ValueError) as exc:
-        raise UsageError(f"argument --model nonlinear: {one_line(exc)}") from None
+        options = {"tire": args.tire or "saturating",
+                   "friction_coefficient": 0.8 if args.friction_coefficient is None else args.friction_coefficient} \
+            if model == "nonlinear" else {k: val for k, val in (("tire", args.tire),
+                                                                ("friction_coefficient", args.friction_coefficient))
+                                          if val is not None}
+        m = build_model(v, model, **options)
+    except (VehicleError, ValueError, TypeError) as exc:
+        raise UsageError(f"argument --model {args.model}: {one_line(exc)}") from None
     try:
         src = sources_of(args, v)
         src.vector(v, args.tire_scale)                    # each source checked against the vehicle

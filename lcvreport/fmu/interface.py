@@ -42,6 +42,10 @@ from ..model.yaw_plane.states import joint_letter
 from ..ranges import RANGES
 
 #: default forward speed [m/s] (50 mph = 22.352 m/s exactly)
+#: the models an FMU is built of (``lcv fmu --model``): the linear ones (Python and native, FMI 2 and 3) and
+#: the nonlinear planar model (Python, FMI 2.0 Co-Simulation)
+FMU_MODELS = ("yaw_plane", "yaw_roll", "nonlinear")
+
 U_START = 22.352
 #: default lowest speed the model is run at [m/s] (5 mph = 2.2352 m/s exactly)
 U_MIN_DEFAULT = 2.2352

@@ -190,7 +190,16 @@ def _family_values(family, case: MeasureCase, model: str, asked: bool) -> tuple[
     if not family.applies(case):
         return {}, {}
     sub = case if on == case.model else dataclasses.replace(case, model=on)
-    values, why = family.compute(sub)
+    try:
+        values, why = family.compute(sub)
+    except KeyError as exc:
+        from ..model.base import MODELS
+        text = str(exc.args[0]) if exc.args else ""
+        if not (callable(MODELS.get(on)) and text.startswith("no signal")):
+            raise
+        # a model registered from outside that gives no signal this family reads (docs/model.md#the-model-object)
+        why = f"undefined: the {on} model gives {text.split(';')[0]} (docs/model.md: what the families read)"
+        return dict.fromkeys(family.keys), dict.fromkeys(family.keys, why)
     if sub is not case:
         case.shared.update(sub.shared)
     return values, why

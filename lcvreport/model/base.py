@@ -88,7 +88,7 @@ def check_model(name: str, allowed=None) -> str:
     key = str(name).replace("-", "_")
     valid = tuple(MODELS) if allowed is None else tuple(allowed)
     if key not in valid:
-        raise ModelError(f"unknown model {name!r}; valid: {', '.join(CLI_NAMES[k] for k in valid)}")
+        raise ModelError(f"unknown model {name!r}; valid: {', '.join(k.replace('_', '-') for k in valid)}")
     return key
 
 
@@ -123,8 +123,12 @@ def build_model(vehicle, name: str = "yaw_plane", **options) -> VehicleModel:
     """
     from .vehicle import check_vehicle
     check_vehicle(vehicle)
-    module, _, builder = MODELS[check_model(name)].partition(":")
-    build = getattr(importlib.import_module(f"{__package__}.{module}"), builder)
+    entry = MODELS[check_model(name)]
+    if callable(entry):                         # a model registered from outside: its builder itself
+        build = entry
+    else:
+        module, _, builder = entry.partition(":")
+        build = getattr(importlib.import_module(f"{__package__}.{module}"), builder)
     return build(vehicle, **options) if options else build(vehicle)
 
 
