@@ -527,23 +527,7 @@ class SampledResponse:
         M = self.matrix()
         return [{cols[i]: float(row[i]) for i in keep} for row in M]
 
-    def to_dict(self) -> dict:
-        """The response as ``lcv simulate --json`` prints it: ``{"columns": [...], "rows": [[...], ...]}``,
-        the columns with their units (``time_s``, ``ay2_m_per_s2`` ...), one row per sample.
-
-        Returns
-        -------
-        dict
-
-        Examples
-        --------
-        >>> from lcvreport import load_preset, respond
-        >>> from lcvreport.manoeuvres.steer import step
-        >>> d = respond(load_preset("aucnat"), "nonlinear", step(0.01), 24.4, 1.0, 0.5).to_dict()
-        >>> d["columns"][0], len(d["rows"])
-        ('time_s', 3)
-        """
-        return {"columns": self.columns(), "rows": (self.matrix() + 0.0).tolist()}    # + 0.0: no -0
+    to_dict = TimeResponse.to_dict               # columns() and matrix(): the same document
 
     def to_pandas(self):
         try:
