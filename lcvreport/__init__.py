@@ -62,6 +62,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``extrema``          extrema between samples (Hermite), the doubling scan
     ``time_response``    the Response protocol; TimeResponse (exact) and SampledResponse (integrated): signals, extrema, plot
     ``integrate``        one implicit integration of any model (Radau), restarted at the steer's breakpoints
+    ``radau_batch``      scipy's Radau over many variants side by side, each with its own steps (a study's turns)
     ``respond``          the response of any model: a linear one's exact, any other's integrated
     ``response``         simulate, step_response: inputs held over intervals (exact)
     ``discretize``       exact zero-order-hold discretization, its cache

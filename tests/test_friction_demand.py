@@ -5,6 +5,7 @@ from the equations written out; a rigid truck's tandem meets the closed-form scr
 friction demand is the tire forces' share of the friction; the CLI and the registry give them."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import subprocess
@@ -27,7 +28,7 @@ LCV = [sys.executable, "-m", "lcvreport.cli"]
 def _stiff(model, factor=1e4):
     """The model with every cornering stiffness times ``factor`` (a test of the limit only: a
     vehicle file cannot hold such numbers)."""
-    object.__setattr__(model, "_CF", model._CF * factor)
+    object.__setattr__(model, "_p", dataclasses.replace(model._p, CF=model._p.CF * factor))
     return model
 
 

@@ -248,8 +248,9 @@ class SchemeAssessment:
         return pd.DataFrame(self.rows())
 
 
-def _groups(scheme: Scheme) -> list[dict]:
-    """Measures whose conditions agree, merged: [{"conditions", "members"}] in the file's order."""
+def scheme_groups(scheme: Scheme) -> list[dict]:
+    """Measures whose conditions agree, merged: [{"conditions", "members", "model"}] in the file's
+    order (each group's measures computed together)."""
     groups = []
     for m in scheme.measures:
         for g in groups:
@@ -320,7 +321,7 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     if sources is not None and sources.crossfall_percent:
         raise ValueError("the crossfall is a condition of the scheme (crossfall_percent), not a source here")
     verdicts = {}
-    for g in _groups(scheme):
+    for g in scheme_groups(scheme):
         cond = g["conditions"]
         speed = kph_to_mps(cond.get("speed_kph", NO_SPEED_KPH))
         f_hz = cond.get("ra_frequency_hz", CONDITIONS["ra_frequency_hz"].default)

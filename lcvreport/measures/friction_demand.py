@@ -32,6 +32,7 @@ Examples
 """
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 
@@ -43,7 +44,7 @@ from ..model.nonlinear.model import FRICTION_COEFFICIENT, driven_axles, nonlinea
 from ..model.vehicle import Vehicle
 from ..units import kph_to_mps
 from .low_speed import ANGLE_DEG, RADIUS_M, LowSpeedTurn, low_speed_turn, turn_of_run
-from ..util.cache import memoized
+from ..util.cache import LRUCache
 from ..util.threads import one_blas_thread
 from .registry import MeasureCase
 
@@ -268,9 +269,21 @@ class TurnWithTireForces:
     stfd: float | None
     friction_demand_drive: float | None
     path_error_max_m: float
-    turn: LowSpeedTurn | None
+    #: the run's poses (:class:`SampledRun`; None: the run left the path) the turn's measures are read on
+    run_table: SampledRun | None
     kinematic: LowSpeedTurn
     undefined: dict = field(default_factory=dict)
+
+    @property
+    def turn(self) -> LowSpeedTurn | None:
+        """The turn's measures (docs/low_speed_turn.md) on this run's poses (None: the run left the
+        path), computed when first read: the friction demand does not need them."""
+        if self.run_table is None:
+            return None
+        cache = self.__dict__.setdefault("_turn", [])
+        if not cache:
+            cache.append(turn_of_run(self.vehicle, self.run_table, self.radius_m, self.angle_deg))
+        return cache[0]
 
     def to_dict(self) -> dict:
         """The JSON of ``lcv turn --model nonlinear``."""
@@ -288,8 +301,6 @@ class TurnWithTireForces:
         return fig_friction_demand(self, limit)
 
 
-@memoized(16)
-@one_blas_thread
 def turn_with_tire_forces(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
                           speed_kph: float = TURN_SPEED_KPH,
                           friction_coefficient: float = FRICTION_COEFFICIENT,
@@ -333,27 +344,169 @@ def turn_with_tire_forces(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_de
     >>> round(t.stfd, 3), t.path_error_max_m < 0.05
     (0.212, True)
     """
+    key = _key(vehicle, radius_m, angle_deg, speed_kph, friction_coefficient, path_gain_rad_per_m, tire,
+               tire_scale, rtol)
+    if key is None:                                 # an argument that does not hash: its own refusal below
+        out = turns_with_tire_forces([vehicle], radius_m, angle_deg, speed_kph, friction_coefficient,
+                                     path_gain_rad_per_m, tire, tire_scale, rtol)[0]
+    else:
+        out = _RESULTS.get(key, lambda: turns_with_tire_forces(
+            [vehicle], radius_m, angle_deg, speed_kph, friction_coefficient, path_gain_rad_per_m, tire, tire_scale,
+            rtol)[0])
+    if isinstance(out, Exception):
+        raise out
+    return out
+
+
+#: the turns computed, by their arguments: a study's batch computes its cases' turns at once
+#: (:func:`prefetch_turns`), each case's assessment then finds its own here
+_RESULTS = LRUCache(256)
+
+
+def _key(vehicle, *args) -> tuple | None:
+    """The cache key of a turn's arguments, or None where one does not hash (a bad argument)."""
+    try:
+        key = (vehicle, *(float(a) if isinstance(a, (int, float)) and not isinstance(a, bool) else a for a in args))
+        hash(key)
+    except TypeError:
+        return None
+    return key
+
+
+def _clear() -> None:
+    _RESULTS.clear()
+
+
+turn_with_tire_forces.cache_clear = _clear
+
+
+def prefetch_turns(vehicles, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
+                   speed_kph: float = TURN_SPEED_KPH, friction_coefficient: float = FRICTION_COEFFICIENT,
+                   path_gain_rad_per_m: float = PATH_GAIN_RAD_PER_M, tire: str = "saturating",
+                   tire_scale: float = 1.0, rtol: float = TURN_RTOL) -> None:
+    """Compute the turns of ``vehicles`` not yet computed in one batch
+    (:func:`turns_with_tire_forces`), so that :func:`turn_with_tire_forces` of each finds it: what
+    a study does before it assesses its cases one by one.  At most the cache's size (256) at once."""
+    args = (radius_m, angle_deg, speed_kph, friction_coefficient, path_gain_rad_per_m, tire, tire_scale, rtol)
+    todo = {}
+    for v in vehicles:
+        key = _key(v, *args)
+        if key is not None and key not in _RESULTS._data and key not in todo:
+            todo[key] = v
+    items = list(todo.items())[:_RESULTS.maxsize]
+    if not items:
+        return
+    for (key, _v), out in zip(items, turns_with_tire_forces([v for _k, v in items], *args)):
+        _RESULTS.get(key, lambda out=out: out)
+
+
+def prefetch_cases(vehicles, tire_scales, keys, conditions: dict | None = None) -> None:
+    """:func:`prefetch_turns` of the cases (``vehicles``, ``tire_scales``) whose measures ``keys``
+    include the friction demand family's, at the ``conditions`` (the registry's, as a scheme
+    group or a study gives them; the rest the defaults): what a study does for a block of its
+    cases before it computes them one by one, each then finding its turn computed."""
+    from .measure_set import check_conditions
+    from .registry import MEASURES
+    if not any(MEASURES[k].family == "friction_demand" for k in keys if k in MEASURES):
+        return
+    given = check_conditions({k: v for k, v in (conditions or {}).items()
+                              if k not in ("speed_kph", "ra_frequency_hz", "crossfall_percent")})
+    scales: dict = {}
+    for v, ts in zip(vehicles, tire_scales):
+        scales.setdefault(float(ts), []).append(v)
+    for ts, group in scales.items():
+        case = MeasureCase(group[0], 1.0, ts, 0.5, conditions=given)
+        prefetch_turns(group, case.condition("turn_radius_m"), case.condition("turn_angle_deg"),
+                       case.condition("turn_speed_kph"), case.condition("friction_coefficient"),
+                       case.condition("path_gain_rad_per_m"), tire_scale=ts)
+
+
+@one_blas_thread
+def turns_with_tire_forces(vehicles, radius_m: float = RADIUS_M, angle_deg: float = ANGLE_DEG,
+                           speed_kph: float = TURN_SPEED_KPH, friction_coefficient: float = FRICTION_COEFFICIENT,
+                           path_gain_rad_per_m: float = PATH_GAIN_RAD_PER_M, tire: str = "saturating",
+                           tire_scale: float = 1.0, rtol: float = TURN_RTOL) -> list:
+    """:func:`turn_with_tire_forces` of every vehicle of ``vehicles``, the variants of one
+    geometry integrated side by side (:func:`lcvreport.analysis.radau_batch.radau_batch`: each
+    with its own steps, the same numbers as alone, bit for bit).  One item per vehicle: its
+    :class:`TurnWithTireForces`, or the exception its turn raised (a vehicle without the turn's
+    keys or a static load, a driven axle out of friction), not raised.
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> from lcvreport import load_vehicle
+    >>> v = load_vehicle("examples/vehicles/b_double.toml")
+    >>> w = dataclasses.replace(v, units=(v.units[0], dataclasses.replace(v.units[1], mass_kg=30000.0), v.units[2]))
+    >>> a, b = turns_with_tire_forces([v, w])
+    >>> a.stfd == turns_with_tire_forces([v])[0].stfd, a.stfd != b.stfd
+    (True, True)
+    """
+    from ..analysis.integrate import ATOL, IntegrationError, input_vector
+    from ..analysis.radau_batch import RowFailure, radau_batch
+    from ..analysis.time_response import SampledResponse
+    from ..model.nonlinear.model import Parameters, TractionError
     from ..ranges import RANGES
     RANGES["speed"].check(kph_to_mps(speed_kph), "turn speed", factor=3.6, unit="km/h")
     RANGES["path_gain"].check(path_gain_rad_per_m, "path_gain_rad_per_m")
-    kinematic = low_speed_turn(vehicle, radius_m, angle_deg)
-    model = nonlinear_model(vehicle, tire, friction_coefficient)
-    kin = kinematic.run
-    path = kin.path
-    u1 = vehicle.units[0]
-    steer_axle = max((a for a in u1.axles if a.steered), key=lambda a: a.x_m)
-    half = steer_axle.track_width_m / 2
+    out: list = [None] * len(vehicles)
+    groups: dict = {}
+    for k, vehicle in enumerate(vehicles):
+        try:
+            kinematic = low_speed_turn(vehicle, radius_m, angle_deg)
+            model = nonlinear_model(vehicle, tire, friction_coefficient)
+        except Exception as exc:                          # the vehicle's own refusal, for its caller to raise
+            out[k] = exc
+            continue
+        groups.setdefault((model.geometry_key(), id(kinematic.run)), []).append((k, vehicle, kinematic, model))
     U = kph_to_mps(speed_kph)
+    for members in groups.values():
+        _k0, vehicle, kinematic, model = members[0]
+        kin = kinematic.run
+        u1 = vehicle.units[0]
+        steer_axle = max((a for a in u1.axles if a.steered), key=lambda a: a.x_m)
+        follow = PathFollowing(model, kin, steer_axle, path_gain_rad_per_m, U)
+        x0 = np.zeros(len(follow.state_names))
+        x0[0], x0[1] = -steer_axle.x_m, -steer_axle.track_width_m / 2      # the outside wheel at the path's start
+        dt = 1.0 / (SAMPLES_PER_M * U)
+        n = max(int(math.ceil(float(kin.path.s_end / U) / dt)), 200)
+        t_end = n * dt
+        w0 = input_vector(model, 0.0, None, tire_scale)
+        params = Parameters.concatenate([m._p for _k, _v, _kin, m in members])
 
-    follow = PathFollowing(model, kin, steer_axle, path_gain_rad_per_m, U)
-    x0 = np.zeros(len(follow.state_names))
-    x0[0], x0[1] = -steer_axle.x_m, -half                      # the outside wheel at the path's start
-    t_end = float(path.s_end / U)
-    dt = 1.0 / (SAMPLES_PER_M * U)
-    n = max(int(math.ceil(t_end / dt)), 200)
-    t_end = n * dt
-    r = integrate(follow, follow, U, t_end, dt, tire_scale, x0=x0, rtol=rtol, label="low-speed turn",
-                  stop=follow.lost)
+        def fun(t, Y, rows, follow=follow, model=model, params=params, w0=w0):
+            W = np.tile(w0, (Y.shape[0], 1))
+            W[:, 0] = follow(t, Y.T)
+            try:
+                dx = model.derivatives(t, Y[:, :-1], W, U, tire_scale, params=params.take(rows))
+            except TractionError as exc:
+                raise RowFailure(exc.row, str(exc)) from None
+            return np.column_stack([dx, U * follow.error(t, Y.T)[1]])
+
+        runs = radau_batch(fun, 0.0, np.tile(x0, (len(members), 1)), t_end, rtol, ATOL,
+                           stop=lambda t, Y, rows, follow=follow: LOST_PATH_M - np.abs(follow.error(t, Y.T)[1]))
+        for (k, vehicle, kinematic, model), run in zip(members, runs):
+            if run.status == -1:
+                out[k] = IntegrationError(run.message)
+                continue
+            mine = copy.copy(follow)
+            mine.model, mine._memo = model, (None, None, None)
+            time = np.linspace(0.0, n * dt, n + 1)
+            end = run.stopped_at if run.status == 1 else t_end
+            if run.status == 1:
+                time = time[time <= run.stopped_at]
+            r = SampledResponse(mine, time, [(0.0, end, run.sol)], U, tire_scale, mine, w0, "low-speed turn")
+            r.stopped_at, r.evaluations, r.steer = run.stopped_at, run.nfev, mine
+            out[k] = _turn_of(vehicle, kinematic, mine, r, radius_m, angle_deg, speed_kph, friction_coefficient,
+                              path_gain_rad_per_m, tire)
+    return out
+
+
+def _turn_of(vehicle, kinematic, follow, r, radius_m, angle_deg, speed_kph, friction_coefficient,
+             path_gain_rad_per_m, tire) -> TurnWithTireForces:
+    """The turn's result of the run ``r`` of ``follow``: friction demands, path error, the
+    turn's measures on its poses."""
+    u1 = vehicle.units[0]
     s_run, e_run = follow.error(r.time, r.state_at(r.time).T)
     s_mono = np.maximum.accumulate(s_run)
     path_error = float(np.abs(e_run).max())
@@ -379,15 +532,14 @@ def turn_with_tire_forces(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_de
     if why is not None:
         stfd = drive = None
         undefined.update({"stfd": why, "friction_demand_drive": why})
-    run = SampledRun.of(follow, r)
+    run = None
     if r.stopped_at is not None:
-        turn = None
         undefined["turn"] = why
     else:
-        turn = turn_of_run(vehicle, run, radius_m, angle_deg)
+        run = SampledRun.of(follow, r)
     return TurnWithTireForces(vehicle, float(radius_m), float(angle_deg), float(speed_kph),
                               float(friction_coefficient), float(path_gain_rad_per_m), tire, r, fd, stfd, drive,
-                              path_error, turn, kinematic, undefined)
+                              path_error, run, kinematic, undefined)
 
 
 def friction_demand_family(case: MeasureCase) -> tuple[dict, dict]:
@@ -408,5 +560,5 @@ def friction_demand_family(case: MeasureCase) -> tuple[dict, dict]:
     return values, {k: why for k, why in t.undefined.items() if k in KEYS}
 
 
-__all__ = ["TurnWithTireForces", "turn_with_tire_forces", "friction_demand_family", "path_coordinates",
+__all__ = ["TurnWithTireForces", "turn_with_tire_forces", "turns_with_tire_forces", "prefetch_turns", "prefetch_cases", "friction_demand_family", "path_coordinates",
            "overall_length_m"]

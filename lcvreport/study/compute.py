@@ -23,10 +23,15 @@ import numpy as np
 from ..analysis.batch import VariantBatch
 from ..analysis.frequency import RA_FREQUENCY_HZ
 from ..measures.registry import BATCHED as BATCH_GROUPS
+from ..measures.friction_demand import prefetch_cases
 from ..measures.registry import FAMILIES, MeasureCase
 from ..model.linear import linear_model
 from ..model.yaw_roll.parameters import missing_roll_data
 from .spec import BATCHED, ROLL_PARAMETERS, Study
+
+#: the cases computed side by side where a measure's manoeuvre is integrated (the turn with tire
+#: forces: :func:`~lcvreport.measures.friction_demand.turns_with_tire_forces`)
+BLOCK = 128
 
 
 def compute_chunk(study: Study, case_ids) -> dict:
@@ -75,8 +80,12 @@ def compute_chunk(study: Study, case_ids) -> dict:
         cols.update(scheme_columns(study, ids))
     rest = [m for m in study.measures if m not in batched]
     if rest:
+        cases = []
         for k, case_id in enumerate(ids):
-            values = study.case_object(int(case_id)).measure_values(rest)   # their families only
+            if k % BLOCK == 0:             # the next block's turns with tire forces, side by side
+                cases = [study.case_object(int(c)) for c in ids[k:k + BLOCK]]
+                prefetch_cases([c.vehicle for c in cases], [c.tire_scale for c in cases], rest)
+            values = cases[k % BLOCK].measure_values(rest)   # their families only
             for m in rest:
                 value = values.get(m)
                 cols[m][k] = np.nan if value is None else float(value)
@@ -88,13 +97,20 @@ def scheme_columns(study: Study, ids: np.ndarray) -> dict:
     ``scheme.<key>`` each scheme measure's value at its conditions (NaN: not computed),
     ``level.<key>`` the level it reaches and ``level_reached`` the case's ("" for none), each
     case as :meth:`~lcvreport.measures.case.Case.assess` of its case (one case at a time)."""
+    from ..measures.assess import scheme_groups
     scheme = study.scheme
     keys = [m.key for m in scheme.measures]
     cols = {f"scheme.{k}": np.full(ids.size, np.nan) for k in keys}
     levels = {f"level.{k}": [] for k in keys}
     reached = []
+    cases = []
     for k, case_id in enumerate(ids):
-        a = study.case_object(int(case_id)).assess(scheme)
+        if k % BLOCK == 0:                 # the next block's turns with tire forces, side by side
+            cases = [study.case_object(int(c)) for c in ids[k:k + BLOCK]]
+            for g in scheme_groups(scheme):
+                prefetch_cases([c.vehicle for c in cases], [c.tire_scale for c in cases],
+                               [r for m in g["members"] for r in (m.key, *m.references)], g["conditions"])
+        a = cases[k % BLOCK].assess(scheme)
         for m in a.measures:
             cols[f"scheme.{m.key}"][k] = np.nan if m.value is None else float(m.value)
             levels[f"level.{m.key}"].append(m.level_reached or "")

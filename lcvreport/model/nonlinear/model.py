@@ -45,7 +45,7 @@ True
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -64,10 +64,11 @@ DRIVE_ITERATIONS = 60
 
 class TractionError(RuntimeError):
     """A driven axle asked for more longitudinal force than its friction allows (F_x >= mu F_z):
-    the speed cannot be held.  ``axle`` names it; the integration adds the time."""
+    the speed cannot be held.  ``axle`` names it, ``row`` the state of a batch that asked; the
+    integration adds the time."""
 
-    def __init__(self, axle: str, needed_N: float, available_N: float):
-        self.axle, self.needed_N, self.available_N = axle, needed_N, available_N
+    def __init__(self, axle: str, needed_N: float, available_N: float, row: int = 0):
+        self.axle, self.needed_N, self.available_N, self.row = axle, needed_N, available_N, row
         super().__init__(f"driven axle {axle} needs {needed_N:.6g} N of longitudinal force per tire, beyond the "
                          f"{available_N:.6g} N its friction allows: the speed cannot be held")
 
@@ -80,6 +81,35 @@ def driven_axles(vehicle: Vehicle) -> list[bool]:
         given = getattr(a, "driven", None)
         out.append(bool(given) if given is not None else (i == 0 and not a.steered))
     return out
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """The parameters of the model that a variant of one geometry may change, one row per
+    variant (V, k): the units' masses ``m`` [kg] and yaw inertias ``I`` [kg m^2] (V, N); per axle
+    (V, n_axles) each tire's ``CF`` [N/rad] and ``CM`` [N m/rad], the dual-tire term's
+    ``tires_CSD2`` (tires C_S D^2) [N m^2], each tire's static load ``Fz_tire`` [N], its friction
+    capacity ``mu_Fz`` [N] and the axle's static load ``Fz0`` [N].  The equations read them per
+    state (:meth:`take`: one row per state), so that states of different variants are evaluated
+    in one call (:class:`StackedNonlinearModel`)."""
+
+    m: np.ndarray
+    I: np.ndarray
+    CF: np.ndarray
+    CM: np.ndarray
+    tires_CSD2: np.ndarray
+    Fz_tire: np.ndarray
+    mu_Fz: np.ndarray
+    Fz0: np.ndarray
+
+    def take(self, rows) -> "Parameters":
+        """The parameters of the variants ``rows`` (an index per state)."""
+        return Parameters(*(getattr(self, f.name)[rows] for f in fields(self)))
+
+    @staticmethod
+    def concatenate(items) -> "Parameters":
+        """One row per variant of ``items`` (each of one or more rows)."""
+        return Parameters(*(np.concatenate([getattr(p, f.name) for p in items]) for f in fields(Parameters)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,8 +138,6 @@ class NonlinearModel:
         N = v.n_units
         set_ = lambda k, val: object.__setattr__(self, k, val)  # noqa: E731 (frozen)
         set_("_N", N)
-        set_("_m", np.array([u.mass_kg for u in v.units]))
-        set_("_I", np.array([u.yaw_inertia_kg_m2 for u in v.units]))
         c = np.zeros((N, N))
         for i in range(N):
             for k in range(N):
@@ -122,28 +150,36 @@ class NonlinearModel:
         set_("_au", np.asarray(v.axle_units, dtype=int))
         set_("_x", np.array([a.x_m for a in axles]))
         set_("_tires", np.array([a.tires for a in axles], dtype=float))
-        set_("_CF", np.array([a.cornering_stiffness_N_per_rad for a in axles]))
-        set_("_CM", np.array([a.aligning_stiffness_Nm_per_rad for a in axles]))
-        set_("_CSD2", np.array([a.longitudinal_stiffness_N * a.dual_spacing_m ** 2 for a in axles]))
         set_("_steered", np.array([a.steered for a in axles], dtype=float))
         driven = np.array(driven_axles(v))
         if not driven.any():
             raise VehicleError("driven", "no axle is driven: unit 1 needs a driven axle (default: its non-steered "
                                          "ones) to hold its speed", f'units[0] "{v.units[0].name}"')
         set_("_driven", driven.astype(float))
-        set_("_Fz0", np.array([a.static_load_N for a in axles]))
-        set_("_Fz_tire", self._Fz0 / self._tires)
         set_("_drive_tires", float((self._tires * self._driven).sum()))
         set_("_law", tire_laws.law(self.tire))
         set_("_linear_tires", self.tire == "linear")
-        set_("_mu_Fz", self.mu * self._Fz_tire)
-        set_("_tires_CSD2", self._tires * self._CSD2)
-        set_("_Idiag", np.diag(self._I))
         set_("_Yhat", np.array([0.0, 1.0]))
         S = np.zeros((N, len(axles)))
         S[self._au, np.arange(len(axles))] = 1.0
         set_("_sum_by_unit", S)
         set_("_drive_share", self._driven * self._tires / self._drive_tires)
+        Fz0 = np.array([a.static_load_N for a in axles])
+        Fz_tire = Fz0 / self._tires
+        row = lambda a: np.asarray(a, dtype=float)[None, :]           # noqa: E731 (one variant: one row)
+        set_("_p", Parameters(m=row([u.mass_kg for u in v.units]), I=row([u.yaw_inertia_kg_m2 for u in v.units]),
+                              CF=row([a.cornering_stiffness_N_per_rad for a in axles]),
+                              CM=row([a.aligning_stiffness_Nm_per_rad for a in axles]),
+                              tires_CSD2=row(self._tires * [a.longitudinal_stiffness_N * a.dual_spacing_m ** 2
+                                                            for a in axles]),
+                              Fz_tire=row(Fz_tire), mu_Fz=row(self.mu * Fz_tire), Fz0=row(Fz0)))
+
+    def geometry_key(self) -> tuple:
+        """What of the model a variant must share with another to be integrated beside it
+        (:class:`StackedNonlinearModel`): everything but :class:`Parameters`."""
+        v = self.vehicle
+        return (self.tire, self.mu, self._c.tobytes(), self._au.tobytes(), self._x.tobytes(), self._tires.tobytes(),
+                self._steered.tobytes(), self._driven.tobytes(), tuple(v.axle_names), v.n_units)
 
     # ------------------------------------------------------------------ names
     @property
@@ -193,11 +229,12 @@ class NonlinearModel:
         v_b = (V * n).sum(axis=2)
         return psi, v1, r, e, n, V, u_b, v_b
 
-    def _slips(self, kin, w, s):
+    def _slips(self, kin, w, s, p):
         """What of the axles' forces does not depend on the drive force: per axle (b, n_axles) the
         slip angle's tangent, the wheels' angle d and its cosine and sine, the forward speed and
         yaw rate of the axle's unit, the steer-independent moments (dual tires, residual T) and
-        the residual lateral force P, from the kinematics ``kin`` (:meth:`_kinematics`)."""
+        the residual lateral force P, from the kinematics ``kin`` (:meth:`_kinematics`) and the
+        parameters ``p`` (:class:`Parameters`, one row per state)."""
         psi, v1, r, e, n, V, u_b, v_b = kin
         delta, P, T, eps, a_c = self.split_input(w)
         au, xs = self._au, self._x
@@ -209,14 +246,14 @@ class NonlinearModel:
         uw = ua * cd + va * sd
         vw = -ua * sd + va * cd
         tan_a = vw / np.where(uw.real > 0, uw, -uw) if np.iscomplexobj(vw) else vw / np.abs(uw)
-        Mz0 = T - s * self._tires_CSD2 * ra / ua
+        Mz0 = T - s * p.tires_CSD2 * ra / ua
         if self._linear_tires:
-            lin = (-s * self._CF * tan_a, s * self._CM * tan_a)
+            lin = (-s * p.CF * tan_a, s * p.CM * tan_a)
         else:
             lin = None
         return tan_a, d, cd, sd, Mz0, P, lin
 
-    def _axle_forces(self, slips, s, D):
+    def _axle_forces(self, slips, s, D, p):
         """Per axle (b, n_axles): wheel-frame F_x, F_y [N], body-frame F_x, F_y, the moment about
         the unit's CG of the axle's forces and moments [N m], the wheels' angle; at drive force
         ``D`` (b,) [N], from the axles' slips (:meth:`_slips`)."""
@@ -225,30 +262,34 @@ class NonlinearModel:
         if lin is not None:
             fy, mz = lin
         else:
-            ratio = fx_tire / self._mu_Fz
+            ratio = fx_tire / p.mu_Fz
             if np.abs(ratio).max() >= 1.0:
                 b, j = (int(k) for k in np.argwhere(np.abs(ratio) >= 1.0)[0])
-                raise TractionError(self.vehicle.axles[j].name, abs(fx_tire[b, j]), self._mu_Fz[j])
+                raise TractionError(self.vehicle.axles[j].name, abs(fx_tire[b, j]), p.mu_Fz[b, j], b)
             mu_y = self.mu * np.sqrt(1.0 - ratio * ratio)
-            fy, mz = tire_laws.saturating(tan_a, s * self._CF, s * self._CM, self._Fz_tire, mu_y)
+            fy, mz = tire_laws.saturating(tan_a, s * p.CF, s * p.CM, p.Fz_tire, mu_y)
         Fx_w, Fy_w = self._tires * fx_tire, self._tires * fy
         Mz = self._tires * mz + Mz0
         Fx_b = Fx_w * cd - Fy_w * sd
         Fy_b = Fx_w * sd + Fy_w * cd + P
         return Fx_w, Fy_w, Fx_b, Fy_b, self._x * Fy_b + Mz, d
 
-    def _solve(self, x, w, U, s):
+    def _solve(self, x, w, U, s, p=None):
         """(z_rest', D, axle forces, kinematics) of a batch of states ``x`` (b, n) and inputs ``w``
         (b, n_w): the generalized accelerations (v1', r') and the drive force D that holds u_1 (the
         u_1 equation, solved with the others: D changes the friction the driven tires have left,
         so the two are iterated to a fixed point from D = 0 -- the same start every call, the
-        same numbers every call)."""
+        same numbers every call); ``p`` the parameters of each state's variant (:class:`Parameters`,
+        one row per state; default this model's)."""
         N = self._N
         kin = self._kinematics(x, U)
         psi, v1, r, e, n, V, u_b, v_b = kin
         a_c = self.split_input(w)[4]
-        m, c = self._m, self._c
+        c = self._c
         B = x.shape[0]
+        if p is None:
+            p = self._p.take(np.zeros(B, dtype=int))
+        m = p.m
         dtype = np.result_type(x, w, float)
         # partial velocities of the CGs: W[b, i, z, :], z = (u1, v1, r1..rN)
         W = np.empty((B, N, N + 2, 2), dtype=dtype)
@@ -257,35 +298,53 @@ class NonlinearModel:
         W[:, :, 2:] = c[None, :, :, None] * n[:, None, :, :]
         bias = ((U * r[:, 0])[:, None] * n[:, 0] - (v1 * r[:, 0])[:, None] * e[:, 0])[:, None, :] \
             - np.einsum("ik,bk,bkc->bic", c, r * r, e)                              # (b, N, 2)
-        Mfull = np.einsum("i,bizc,biyc->bzy", m, W, W)
-        Mfull[:, 2:, 2:] += self._Idiag
+        Mfull = np.einsum("bi,bizc,biyc->bzy", m, W, W)
+        Mfull[:, np.arange(2, N + 2), np.arange(2, N + 2)] += p.I
         Mr = Mfull[:, 1:, 1:]
         au = self._au
         e_au, n_au = e[:, au], n[:, au]
-        ext = (m[None, :] * a_c[:, None])[:, :, None] * self._Yhat - m[None, :, None] * bias
+        ext = (m * a_c[:, None])[:, :, None] * self._Yhat - m[:, :, None] * bias
         inertial = np.einsum("bizc,bic->bz", W, ext)
-        D = np.zeros(B, dtype=dtype)
-        slips = self._slips(kin, w, s)
+        slips = self._slips(kin, w, s, p)
         Mr_inv = np.linalg.inv(Mr)                      # once for every pass of the drive force
+        na = self._x.size
+        D = np.zeros(B, dtype=dtype)
+        zr = np.empty((B, N + 1), dtype=dtype)
+        forces = [np.empty((B, na), dtype=dtype) for _ in range(6)]
+        # each state iterates until its own drive force has converged (a state's numbers do not
+        # depend on the others of its batch)
+        rows = np.arange(B)
         for _ in range(DRIVE_ITERATIONS):
-            Fx_w, Fy_w, Fx_b, Fy_b, moment, d = self._axle_forces(slips, s, D)
-            Fa = Fx_b[:, :, None] * e_au + Fy_b[:, :, None] * n_au                   # per axle, ground
+            every = rows.size == B
+            pick = (lambda a: a) if every else (lambda a: a[rows])            # noqa: E731
+            sl = tuple(None if a is None else (tuple(pick(b) for b in a) if isinstance(a, tuple) else pick(a))
+                       for a in slips)
+            try:
+                Fx_w, Fy_w, Fx_b, Fy_b, moment, d = self._axle_forces(sl, s, D[rows], p if every else p.take(rows))
+            except TractionError as exc:                # the row of the batch, not of the pass
+                exc.row = int(rows[exc.row])
+                raise
+            Fa = Fx_b[:, :, None] * pick(e_au) + Fy_b[:, :, None] * pick(n_au)       # per axle, ground
             F = np.einsum("ij,bjc->bic", self._sum_by_unit, Fa)
-            rhs = inertial + np.einsum("bizc,bic->bz", W, F)
-            rhs[:, 2:] += moment @ self._sum_by_unit.T
-            zr = np.einsum("bij,bj->bi", Mr_inv, rhs[:, 1:])
+            rhs = pick(inertial) + np.einsum("bizc,bic->bz", pick(W), F)
+            rhs[:, 2:] += np.einsum("bj,ij->bi", moment, self._sum_by_unit)     # not BLAS: row by row
+            z = np.einsum("bij,bj->bi", pick(Mr_inv), rhs[:, 1:])
             # the u1 equation: the drive force's generalized force along u1 is D times its
             # direction's projection on e1 (1 for unsteered driven axles); solved for D
             g = (self._drive_share * np.cos(d)).sum(axis=1)
-            D_new = D + (np.einsum("bz,bz->b", Mfull[:, 0, 1:], zr) - rhs[:, 0]) / g
+            D_new = D[rows] + (np.einsum("bz,bz->b", pick(Mfull)[:, 0, 1:], z) - rhs[:, 0]) / g
             # with linear tires and the driven axles straight (no steer, no misalignment) the drive
             # force acts in the u1 equation alone: one pass gives it exactly
-            decoupled = self._linear_tires and not np.any(d * self._driven)
-            done = decoupled or np.all(np.abs(D_new - D) <= DRIVE_RTOL * np.maximum(1.0, np.abs(D_new)))
-            D = D_new
-            if done:
+            decoupled = self._linear_tires & ~np.any(d * self._driven, axis=1)
+            done = decoupled | (np.abs(D_new - D[rows]) <= DRIVE_RTOL * np.maximum(1.0, np.abs(D_new)))
+            zr[rows], D[rows] = z, D_new
+            for out, val in zip(forces, (Fx_w, Fy_w, Fx_b, Fy_b, moment, d)):
+                out[rows] = val
+            rows = rows[~done]
+            if rows.size == 0:
                 break
-        return zr, D, (Fx_w, Fy_w, Fx_b, Fy_b, moment, d), kin + (W, bias)
+        Fx_w, Fy_w, Fx_b, Fy_b, moment, d = forces
+        return zr, D, (Fx_w, Fy_w, Fx_b, Fy_b, moment, d), kin + (W, bias), p
 
     def _batch(self, x, w):
         """``x``, ``w`` as 2-D batches (rows: states), and whether one state was given."""
@@ -296,10 +355,12 @@ class NonlinearModel:
         return x2, w2, one
 
     def derivatives(self, t: float, x: np.ndarray, w: np.ndarray, speed_mps: float,
-                    tire_scale: float = 1.0) -> np.ndarray:
+                    tire_scale: float = 1.0, params: Parameters | None = None) -> np.ndarray:
         """``x'`` [SI] at state ``x``, inputs ``w`` (:attr:`input_names`), unit 1's forward speed
         ``speed_mps`` [m/s] held, the tire coefficients times ``tire_scale``; ``x`` may be a batch
-        (rows: states), ``w`` one input for all of them or one per row.
+        (rows: states), ``w`` one input for all of them or one per row; ``params`` each row's
+        variant's :class:`Parameters` (one row per state; default this model's: variants of one
+        geometry evaluated in one call, :func:`lcvreport.measures.friction_demand.turns_with_tire_forces`).
 
         Raises
         ------
@@ -308,7 +369,7 @@ class NonlinearModel:
         """
         N = self._N
         x2, w2, one = self._batch(x, w)
-        zr, D, _forces, (psi, v1, r, e, n, V, *_rest) = self._solve(x2, w2, float(speed_mps), tire_scale)
+        zr, D, _forces, (psi, v1, r, e, n, V, *_rest), _p = self._solve(x2, w2, float(speed_mps), tire_scale, params)
         dx = np.empty((x2.shape[0], 2 * N + 3), dtype=zr.dtype)
         dx[:, 0:2] = V[:, 0]
         dx[:, 2:2 + N] = r
@@ -325,7 +386,7 @@ class NonlinearModel:
         for a batch (rows of ``x``)."""
         x2, w2, one = self._batch(np.asarray(x, dtype=float), np.asarray(w, dtype=float))
         N, U = self._N, float(speed_mps)
-        zr, D, (Fx_w, Fy_w, *_f, d), (psi, v1, r, e, n, V, u_b, v_b, W, bias) = self._solve(x2, w2, U, tire_scale)
+        zr, D, (Fx_w, Fy_w, *_f, d), (psi, v1, r, e, n, V, u_b, v_b, W, bias), p = self._solve(x2, w2, U, tire_scale)
         z = np.concatenate([np.zeros((x2.shape[0], 1)), zr], axis=1)     # (u1' = 0, v1', r')
         A = np.einsum("bizc,bz->bic", W, z) + bias                       # CG accelerations (ground)
         P = np.zeros((x2.shape[0], N, 2))
@@ -349,7 +410,7 @@ class NonlinearModel:
             xs = max(a.x_m for a in v.steered_axles)
             point = A[:, 0] + xs * (zr[:, 1, None] * n[:, 0] - (r[:, 0] ** 2)[:, None] * e[:, 0])
             out["a_steer"] = (point * n[:, 0]).sum(axis=1)
-        fd = np.hypot(Fx_w, Fy_w) / (self.mu * self._Fz0)
+        fd = np.hypot(Fx_w, Fy_w) / (self.mu * p.Fz0)
         for j, a in enumerate(v.axles):
             out[f"Fx_{a.name}"], out[f"Fy_{a.name}"], out[f"fd_{a.name}"] = Fx_w[:, j], Fy_w[:, j], fd[:, j]
         for j, a in enumerate(v.axles):
