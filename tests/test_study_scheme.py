@@ -85,3 +85,39 @@ def test_a_scheme_with_a_speed_factor_is_refused(tmp_path):
     q = subprocess.run(LCV + ["study", str(study_file), "--out", str(tmp_path / "o"), "--scheme", str(scheme_file)],
                        capture_output=True, text=True, timeout=60)
     assert q.returncode == 2 and "limited by a min" in q.stderr and q.stderr.count("\n") == 1
+
+
+def test_the_batched_families_of_a_scheme_give_each_case_its_own_assessment():
+    """A scheme study's batch (assess.batched_group_values: the roll, rollover, yaw damping, single
+    sine and steady-turn families over the block's vehicles) against assess of each vehicle alone:
+    every value to 1e-12 relative, every verdict and level the same."""
+    import dataclasses
+
+    from lcvreport.measures.assess import batched_group_values
+    from lcvreport.measures.scheme import loads_scheme
+    from lcvreport.model.vehicle_file import load_vehicle
+    text = (EXAMPLES.parents[1] / "examples" / "schemes" / "template.toml").read_text()
+    scheme = loads_scheme(text[:text.index("[measures.stfd]")])
+    v = load_vehicle(EXAMPLES / "b_double.toml")
+    variants = []
+    for mass, stiffness, height in ((1.0, 1.0, 1.0), (0.7, 1.1, 1.2), (1.1, 0.9, 0.85), (0.9, 1.05, 1.3)):
+        units = [v.units[0]] + [dataclasses.replace(
+            u, mass_kg=u.mass_kg * mass, cg_height_m=u.cg_height_m * height,
+            axles=tuple(dataclasses.replace(a, cornering_stiffness_N_per_rad=a.cornering_stiffness_N_per_rad * stiffness)
+                        for a in u.axles)) for u in v.units[1:]]
+        variants.append(dataclasses.replace(v, units=tuple(units)))
+    pre = batched_group_values(v, variants, scheme)
+    given = {k for groups in pre for g in groups for k in g}
+    assert {"srt_rrcu_g", "yaw_damping_coefficient", "rltr_lane_change", "ra_yaw_rate_single_sine",
+            "ra_lane_change_roll", "hsto_m_roll", "hsso_m"} <= given          # the batch did the work
+    reached = set()
+    for w, p in zip(variants, pre):
+        alone, batched = assess(w, scheme).to_dict(), assess(w, scheme, precomputed=p).to_dict()
+        for a, b in zip(alone["measures"], batched["measures"]):
+            assert (a["value"] is None) == (b["value"] is None), a["key"]
+            if a["value"] is not None:
+                assert b["value"] == pytest.approx(a["value"], rel=1e-12, abs=1e-15), a["key"]
+            assert a["verdicts"] == b["verdicts"] and a["level_reached"] == b["level_reached"]
+        assert alone["level_reached"] == batched["level_reached"]
+        reached.add(tuple(m["level_reached"] for m in alone["measures"]))
+    assert len(reached) >= 2                          # the variants' measures reach different levels

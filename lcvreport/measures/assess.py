@@ -264,8 +264,8 @@ def scheme_groups(scheme: Scheme) -> list[dict]:
 
 
 @one_blas_thread
-def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units=None, sources=None
-           ) -> SchemeAssessment:
+def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units=None, sources=None,
+           precomputed: list | None = None) -> SchemeAssessment:
     """Every measure of ``scheme`` of ``vehicle`` at its conditions, judged per level.
 
     Parameters
@@ -281,6 +281,9 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
         Units carrying the 1 % rule: a residual source of the trim and the straight path.
     sources : lcvreport.model.yaw_plane.loads.ResidualSources, optional
         Further residual sources (the crossfall is the scheme's condition ``crossfall_percent``).
+    precomputed : list of dict, optional
+        Per group of :func:`scheme_groups`, values already computed for this vehicle
+        ({key: value}: a study's batch, :func:`batched_group_values`); the rest is computed here.
 
     Returns
     -------
@@ -321,7 +324,7 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     if sources is not None and sources.crossfall_percent:
         raise ValueError("the crossfall is a condition of the scheme (crossfall_percent), not a source here")
     verdicts = {}
-    for g in scheme_groups(scheme):
+    for gi, g in enumerate(scheme_groups(scheme)):
         cond = g["conditions"]
         speed = kph_to_mps(cond.get("speed_kph", NO_SPEED_KPH))
         f_hz = cond.get("ra_frequency_hz", CONDITIONS["ra_frequency_hz"].default)
@@ -333,8 +336,11 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
         if any(k.startswith("trim.") for k in keys):           # the trim is one result: both of its keys
             keys += [k for k in ("trim.delta_rad", "trim.offtracking_m") if k not in keys]
         reasons = {}
-        values = measure_values(vehicle, speed, keys, tire_scale, load_units, f_hz, src if src else None,
-                                others, reasons=reasons, model=g["model"])
+        given = precomputed[gi] if precomputed else {}
+        rest = [k for k in keys if k not in given]
+        values = measure_values(vehicle, speed, rest, tire_scale, load_units, f_hz, src if src else None,
+                                others, reasons=reasons, model=g["model"]) if rest else {}
+        values = {k: given[k] if k in given else values[k] for k in keys}
         doc = dict(values)
         if any(k.startswith("trim.") for k in keys):
             doc["trim"] = None if values.get("trim.delta_rad") is None else {
@@ -364,6 +370,73 @@ def assess(vehicle: Vehicle, scheme: Scheme, tire_scale: float = 1.0, load_units
     a = SchemeAssessment(vehicle, scheme, measures, reached, reason, float(tire_scale),
                          tuple(load_units) if load_units else (), sources)
     return a.with_files(files.get("vehicle"), files.get("scheme")) if files else a
+
+
+def batched_group_values(vehicle: Vehicle, variants, scheme: Scheme, tire_scale: float = 1.0) -> list:
+    """What of ``scheme``'s groups (:func:`scheme_groups`) has a batched form, for every vehicle of
+    ``variants`` (of ``vehicle``'s geometry) at once: per variant, per group, ``{key: value}`` --
+    the ``precomputed`` of :func:`assess`, which computes the rest.  A family is batched where the
+    registry gives it a batched function that reads no residual force (no trim, no crossfall) on
+    the yaw-plane or yaw-roll model; a variant's value that the batch leaves undefined (NaN) is
+    not given (:func:`assess` computes it, with its reason), but for the yaw damping coefficient's
+    lower bound, which the batch leaves NaN exactly where the coefficient is defined (None
+    there).  Each value equals :func:`assess`'s own to 1e-12 (tests/test_study_scheme.py).
+
+    Examples
+    --------
+    >>> from lcvreport import load_vehicle
+    >>> from lcvreport.measures.scheme import load_scheme
+    >>> v = load_vehicle("examples/vehicles/b_double.toml")
+    >>> s = load_scheme("examples/schemes/template.toml")
+    >>> pre = batched_group_values(v, [v], s)
+    >>> a = assess(v, s, precomputed=pre[0])
+    >>> a.to_dict()["measures"][0]["value"] == assess(v, s).to_dict()["measures"][0]["value"]
+    True
+    """
+    from ..analysis.batch import BatchError, VariantBatch
+    from .measure_set import check_conditions
+    from .registry import FAMILIES, MeasureCase, model_of_family
+    variants = list(variants)
+    out = [[{} for _ in scheme_groups(scheme)] for _ in variants]
+    batches = {}
+    for gi, g in enumerate(scheme_groups(scheme)):
+        cond = g["conditions"]
+        keys = list(dict.fromkeys([k for m in g["members"] for k in (m.key, *m.references)]))
+        if "yaw_damping_coefficient" in keys:
+            keys.append("yaw_damping_lower_bound")
+        speed = kph_to_mps(cond.get("speed_kph", NO_SPEED_KPH))
+        f_hz = cond.get("ra_frequency_hz", CONDITIONS["ra_frequency_hz"].default)
+        others = check_conditions({k: v for k, v in cond.items()
+                                   if k not in ("speed_kph", "ra_frequency_hz", "crossfall_percent")})
+        for name, family in FAMILIES.items():
+            asked = [k for k in keys if MEASURES[k].family == name]
+            if not asked or not family.batched or any(k not in family.batched_keys for k in asked) \
+                    or "crossfall_percent" in family.conditions:
+                continue
+            model, _why = model_of_family(family, g["model"])
+            if model not in ("yaw_plane", "yaw_roll") or "F" in family.batched_parameters():
+                continue
+            if family.needs == "steer" and not vehicle.steered_axles:
+                continue
+            case = MeasureCase(vehicle, speed, float(tire_scale), float(f_hz), None, conditions=others, model=model)
+            if not family.applies(case):
+                continue
+            if model not in batches:
+                try:
+                    batches[model] = VariantBatch.of_vehicles(vehicle, variants, model)
+                except (BatchError, ValueError):                # not one geometry: case by case
+                    batches[model] = None
+            if batches[model] is None:
+                continue
+            arrays = family.compute_batched(batches[model], case)
+            for b in range(len(variants)):
+                got = {k: float(arrays[k][b]) for k in asked}
+                if name == "yaw_damping" and np.isfinite(got.get("yaw_damping_coefficient", np.nan)):
+                    got["yaw_damping_lower_bound"] = None if np.isnan(got.get("yaw_damping_lower_bound", 0.0)) \
+                        else got["yaw_damping_lower_bound"]
+                if all(v is None or np.isfinite(v) for v in got.values()):
+                    out[b][gi].update(got)
+    return out
 
 
 def _verdict(m, doc: dict, levels) -> MeasureVerdict:

@@ -157,17 +157,18 @@ class Case:
         return measure_values(subject, self._speed(), keys, self.tire_scale, self.load_units or None, self.f_hz,
                               self.sources, self.manoeuvre_conditions(), reasons, model)
 
-    def assess(self, scheme):
+    def assess(self, scheme, precomputed: list | None = None):
         """Every measure of ``scheme`` at its own conditions, judged per level
         (:func:`~lcvreport.measures.assess.assess`): the case's vehicle, tire scale, load case and
-        residual sources (the scheme gives each measure's speed and conditions).
+        residual sources (the scheme gives each measure's speed and conditions); ``precomputed``
+        as :func:`~lcvreport.measures.assess.assess`'s (a study's batch).
 
         Returns
         -------
         SchemeAssessment
         """
         from .assess import assess
-        return assess(self.vehicle, scheme, self.tire_scale, self.load_units or None, self.sources)
+        return assess(self.vehicle, scheme, self.tire_scale, self.load_units or None, self.sources, precomputed)
 
     def respond(self, steer, t_end: float, dt: float):
         """The response of the case's model to ``steer`` from rest at its speed, sampled every

@@ -269,8 +269,9 @@ class TurnWithTireForces:
     stfd: float | None
     friction_demand_drive: float | None
     path_error_max_m: float
-    #: the run's poses (:class:`SampledRun`; None: the run left the path) the turn's measures are read on
-    run_table: SampledRun | None
+    #: the path-following law the run was steered by (None: the run left the path): the turn's
+    #: measures are read on the run's poses (:class:`SampledRun`), tabulated when first read
+    follow: PathFollowing | None
     kinematic: LowSpeedTurn
     undefined: dict = field(default_factory=dict)
 
@@ -278,11 +279,12 @@ class TurnWithTireForces:
     def turn(self) -> LowSpeedTurn | None:
         """The turn's measures (docs/low_speed_turn.md) on this run's poses (None: the run left the
         path), computed when first read: the friction demand does not need them."""
-        if self.run_table is None:
+        if self.follow is None:
             return None
         cache = self.__dict__.setdefault("_turn", [])
         if not cache:
-            cache.append(turn_of_run(self.vehicle, self.run_table, self.radius_m, self.angle_deg))
+            cache.append(turn_of_run(self.vehicle, SampledRun.of(self.follow, self.response), self.radius_m,
+                                     self.angle_deg))
         return cache[0]
 
     def to_dict(self) -> dict:
@@ -532,14 +534,11 @@ def _turn_of(vehicle, kinematic, follow, r, radius_m, angle_deg, speed_kph, fric
     if why is not None:
         stfd = drive = None
         undefined.update({"stfd": why, "friction_demand_drive": why})
-    run = None
     if r.stopped_at is not None:
         undefined["turn"] = why
-    else:
-        run = SampledRun.of(follow, r)
     return TurnWithTireForces(vehicle, float(radius_m), float(angle_deg), float(speed_kph),
                               float(friction_coefficient), float(path_gain_rad_per_m), tire, r, fd, stfd, drive,
-                              path_error, run, kinematic, undefined)
+                              path_error, None if r.stopped_at is not None else follow, kinematic, undefined)
 
 
 def friction_demand_family(case: MeasureCase) -> tuple[dict, dict]:

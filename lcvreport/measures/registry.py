@@ -187,6 +187,10 @@ class Family:
         """The keys the batched function gives (the scalar ones), in order."""
         return tuple(k for k in self.keys if MEASURES[k].shape == "scalar") if self.batched else ()
 
+    def batched_parameters(self) -> tuple[str, ...]:
+        """The names its batched function takes (``F``: a residual force; empty: no batched form)."""
+        return tuple(inspect.signature(_resolve(self.batched)).parameters) if self.batched else ()
+
     def applies(self, case: MeasureCase) -> bool:
         """Whether the family is computed at all (a trim only with a residual source)."""
         return self.needs != "sources" or case.F is not None

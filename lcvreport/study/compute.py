@@ -105,12 +105,13 @@ def scheme_columns(study: Study, ids: np.ndarray) -> dict:
     reached = []
     cases = []
     for k, case_id in enumerate(ids):
-        if k % BLOCK == 0:                 # the next block's turns with tire forces, side by side
+        if k % BLOCK == 0:                 # the next block: its turns with tire forces, its batched families
             cases = [study.case_object(int(c)) for c in ids[k:k + BLOCK]]
             for g in scheme_groups(scheme):
                 prefetch_cases([c.vehicle for c in cases], [c.tire_scale for c in cases],
                                [r for m in g["members"] for r in (m.key, *m.references)], g["conditions"])
-        a = cases[k % BLOCK].assess(scheme)
+            pre = _batched_scheme_values(study, cases, scheme)
+        a = cases[k % BLOCK].assess(scheme, pre[k % BLOCK])
         for m in a.measures:
             cols[f"scheme.{m.key}"][k] = np.nan if m.value is None else float(m.value)
             levels[f"level.{m.key}"].append(m.level_reached or "")
@@ -118,6 +119,24 @@ def scheme_columns(study: Study, ids: np.ndarray) -> dict:
     cols.update({name: np.array(v, dtype=object) for name, v in levels.items()})
     cols["level_reached"] = np.array(reached, dtype=object)
     return cols
+
+
+def _batched_scheme_values(study: Study, cases: list, scheme) -> list:
+    """Per case, the ``precomputed`` of its assessment: the scheme's batched families over the
+    cases of one tire scale without a load case or residual sources (those, and a study that
+    moves the geometry, are assessed case by case)."""
+    from ..measures.assess import batched_group_values
+    pre: list = [None] * len(cases)
+    if study.moves_geometry:
+        return pre
+    scales: dict = {}
+    for k, c in enumerate(cases):
+        if not c.load_units and c.sources is None:
+            scales.setdefault(c.tire_scale, []).append(k)
+    for ts, rows in scales.items():
+        for k, values in zip(rows, batched_group_values(study.vehicle, [cases[k].vehicle for k in rows], scheme, ts)):
+            pre[k] = values
+    return pre
 
 
 def _case_force(study: Study, case_id: int) -> np.ndarray:
