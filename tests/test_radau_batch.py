@@ -41,7 +41,7 @@ def test_each_variant_takes_scipys_steps_and_reaches_its_values():
         t = np.linspace(0.0, 6.0, 61)
         scale = np.abs(ref.sol(t)).max(axis=1)
         assert np.abs(runs[k].sol(t) - ref.sol(t)).max(axis=1) / scale == pytest.approx([0, 0], abs=1e-4)
-        # and to the closed form where there is one: mu -> 0 ... here: a tighter run of scipy
+        # and to the solution itself (no closed form: scipy at rtol 1e-11)
         tight = solve_ivp(lambda t, y: [y[1], mu * (1 - y[0] ** 2) * y[1] - y[0]], (0.0, 6.0), [2.0, 0.0],
                           method="Radau", rtol=1e-11, atol=1e-13)
         assert np.abs(runs[k].sol(6.0) - tight.y[:, -1]).max() < 2e-4 * max(1.0, np.abs(tight.y[:, -1]).max())
@@ -139,3 +139,30 @@ def test_the_turn_equals_scipys_solve_ivp_of_the_same_equations():
         assert ours.friction_demand[a.name] == pytest.approx(float(np.max(ref[f"fd_{a.name}"])), abs=1e-7)
     t = ref.time
     assert np.abs(ours.response.state_at(t)[:, :2] - ref.state_at(t)[:, :2]).max() < 1e-6     # positions [m]
+
+
+def test_a_study_blocks_prefetched_turns_are_the_ones_its_cases_ask_for(monkeypatch):
+    """prefetch_cases computes a block's turns under the keys that each case's assessment looks
+    up: the cases then compute no turn of their own (a key that did not match would be silently
+    slow, each case integrating its turn alone)."""
+    from lcvreport.measures import friction_demand as fd
+    from lcvreport.measures.case import Case
+    from lcvreport.measures.scheme import loads_scheme
+    v = load_vehicle(EXAMPLES / "b_double.toml")
+    vs = [_variant(v, 0.85, 1.0), _variant(v, 0.95, 1.05)]
+    scheme = loads_scheme("""
+scheme = "stfd"
+levels = ["L1"]
+[measures.stfd]
+turn_speed_kph = 5.0
+friction_coefficient = 0.7
+source = "test"
+levels = { L1 = { max = 0.8 } }
+""")
+    fd.turn_with_tire_forces.cache_clear()
+    fd.prefetch_cases(vs, [1.0, 1.0], ["stfd"], {"turn_speed_kph": 5.0, "friction_coefficient": 0.7})
+    calls = []
+    real = fd.turns_with_tire_forces
+    monkeypatch.setattr(fd, "turns_with_tire_forces", lambda *a, **k: calls.append(a) or real(*a, **k))
+    values = [Case(w).assess(scheme).measures[0].value for w in vs]
+    assert calls == [] and all(0.0 < x < 1.0 for x in values)

@@ -393,7 +393,7 @@ def prefetch_turns(vehicles, radius_m: float = RADIUS_M, angle_deg: float = ANGL
     todo = {}
     for v in vehicles:
         key = _key(v, *args)
-        if key is not None and key not in _RESULTS._data and key not in todo:
+        if key is not None and key not in _RESULTS and key not in todo:
             todo[key] = v
     items = list(todo.items())[:_RESULTS.maxsize]
     if not items:

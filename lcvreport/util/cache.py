@@ -45,6 +45,10 @@ class LRUCache:
     def __len__(self) -> int:
         return len(self._data)
 
+    def __contains__(self, key: Hashable) -> bool:
+        """Whether ``key`` is cached (without counting as a use)."""
+        return key in self._data
+
 
 def memoized(maxsize: int = 32):
     """A decorator: ``functools.lru_cache(maxsize)`` over the function, used only when every
