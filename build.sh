@@ -52,7 +52,11 @@ python_env() {
     fi
 }
 
-setup() { system_packages; python_env; }
+# the nonlinear model's compiled equations (lcvreport/model/nonlinear/native.py): made now, not
+# at the first command that needs them
+native() { "$PY" -m lcvreport.model.nonlinear.native >&2; }
+
+setup() { system_packages; python_env; native; }
 
 docs() {
     rm -rf build/docs

@@ -38,6 +38,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
         ``kinematics``   pull points, the heading law, the integration along a path (scipy)
     ``nonlinear/``       the nonlinear planar model (docs/nonlinear.md): any angle, saturating tires:
         ``model``        the planar multibody chain, Kane's equations, the held speed, outputs
+        ``native``       the equations compiled (equations.c, ctypes): the same numbers, ~6x faster a call
         ``tires``        the tire laws, linear and brush, vectorized over the axles
 ``manoeuvres/``          **what the driver and the road do**, independent of any model:
     ``steer``            steer inputs as continuous functions (step, sine, pulse, table, lane change)

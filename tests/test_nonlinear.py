@@ -158,10 +158,11 @@ def test_the_model_is_newton_euler_at_any_angle(name, tire):
         w[1 + 2 * na:1 + 3 * na] = rng.normal(size=na) * 0.01
         w[-1] = 0.3
         U = rng.uniform(3.0, 25.0)
-        got = m.derivatives(0.0, x, w, U)
         ref, D = newton_euler(v, x, w, U, tire=tire)
         scale = np.abs(ref).max()
-        assert np.abs(got - ref).max() <= 1e-9 * scale, np.abs(got - ref).max() / scale
+        # the compiled equations (native.py) and the numpy ones, each
+        for got in (m.derivatives(0.0, x, w, U), m.derivatives_numpy(0.0, x, w, U)):
+            assert np.abs(got - ref).max() <= 1e-9 * scale, np.abs(got - ref).max() / scale
         assert m.drive_force(x, w, U) == pytest.approx(D, rel=1e-8, abs=1e-6)
 
 

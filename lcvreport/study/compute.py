@@ -76,14 +76,21 @@ def compute_chunk(study: Study, case_ids) -> dict:
                 for name, arr in arrays.items():
                     if name in batched:
                         cols[name][rows] = np.broadcast_to(arr, rows.shape)
+    made: dict = {}                       # each case's Case made once (its vehicle: 5 ms)
+
+    def case_object(case_id: int):
+        if case_id not in made:
+            made[case_id] = study.case_object(case_id)
+        return made[case_id]
+
     if study.scheme_toml is not None:
-        cols.update(scheme_columns(study, ids))
+        cols.update(scheme_columns(study, ids, case_object))
     rest = [m for m in study.measures if m not in batched]
     if rest:
         cases = []
         for k, case_id in enumerate(ids):
             if k % BLOCK == 0:             # the next block's turns with tire forces, side by side
-                cases = [study.case_object(int(c)) for c in ids[k:k + BLOCK]]
+                cases = [case_object(int(c)) for c in ids[k:k + BLOCK]]
                 prefetch_cases([c.vehicle for c in cases], [c.tire_scale for c in cases], rest)
             values = cases[k % BLOCK].measure_values(rest)   # their families only
             for m in rest:
@@ -92,12 +99,15 @@ def compute_chunk(study: Study, case_ids) -> dict:
     return cols
 
 
-def scheme_columns(study: Study, ids: np.ndarray) -> dict:
+def scheme_columns(study: Study, ids: np.ndarray, case_object=None) -> dict:
     """The assessment of every case against the study's scheme (docs/studies.md#schemes):
     ``scheme.<key>`` each scheme measure's value at its conditions (NaN: not computed),
     ``level.<key>`` the level it reaches and ``level_reached`` the case's ("" for none), each
-    case as :meth:`~lcvreport.measures.case.Case.assess` of its case (one case at a time)."""
+    case as :meth:`~lcvreport.measures.case.Case.assess` of its case (one case at a time);
+    ``case_object(case_id)`` makes a case's :class:`~lcvreport.measures.case.Case` (default
+    :meth:`Study.case_object`)."""
     from ..measures.assess import scheme_groups
+    case_object = case_object or study.case_object
     scheme = study.scheme
     keys = [m.key for m in scheme.measures]
     cols = {f"scheme.{k}": np.full(ids.size, np.nan) for k in keys}
@@ -106,7 +116,7 @@ def scheme_columns(study: Study, ids: np.ndarray) -> dict:
     cases = []
     for k, case_id in enumerate(ids):
         if k % BLOCK == 0:                 # the next block: its turns with tire forces, its batched families
-            cases = [study.case_object(int(c)) for c in ids[k:k + BLOCK]]
+            cases = [case_object(int(c)) for c in ids[k:k + BLOCK]]
             for g in scheme_groups(scheme):
                 prefetch_cases([c.vehicle for c in cases], [c.tire_scale for c in cases],
                                [r for m in g["members"] for r in (m.key, *m.references)], g["conditions"])

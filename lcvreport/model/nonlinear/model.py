@@ -45,6 +45,7 @@ True
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -274,6 +275,38 @@ class NonlinearModel:
         Fy_b = Fx_w * sd + Fy_w * cd + P
         return Fx_w, Fy_w, Fx_b, Fy_b, self._x * Fy_b + Mz, d
 
+    def _partials(self, kin, U, dtype):
+        """(W, bias): the CGs' partial velocities ``W[b, i, z, :]``, z = (u1, v1, r1..rN), and the
+        part of their accelerations not proportional to the generalized accelerations (b, N, 2)."""
+        psi, v1, r, e, n, V, u_b, v_b = kin
+        B, N, c = psi.shape[0], self._N, self._c
+        W = np.empty((B, N, N + 2, 2), dtype=dtype)
+        W[:, :, 0] = e[:, None, 0]
+        W[:, :, 1] = n[:, None, 0]
+        W[:, :, 2:] = c[None, :, :, None] * n[:, None, :, :]
+        bias = ((U * r[:, 0])[:, None] * n[:, 0] - (v1 * r[:, 0])[:, None] * e[:, 0])[:, None, :] \
+            - np.einsum("ik,bk,bkc->bic", c, r * r, e)                              # (b, N, 2)
+        return W, bias
+
+    def _solve_outputs(self, x, w, U, s):
+        """What :meth:`outputs` reads of :meth:`_solve`, by the compiled equations where the
+        machine has them (the accelerations and the axles' wheel-frame forces; the kinematics by
+        numpy, no iteration in them)."""
+        eq = _compiled(self) if x.dtype == np.float64 and w.dtype.kind in "fiu" else None
+        if eq is None:
+            return self._solve(x, w, U, s)
+        B = x.shape[0]
+        p = self._p.take(np.zeros(B, dtype=int))
+        dx, D, got = eq.derivatives(x, w, U, s, p, forces=True)
+        if dx is None:
+            row, j, needed, available = got
+            raise TractionError(self.vehicle.axles[j].name, needed, available, row)
+        kin = self._kinematics(x, U)
+        W, bias = self._partials(kin, U, np.float64)
+        delta, _P, _T, eps, _a_c = self.split_input(w)
+        d = delta[:, None] * self._steered + eps
+        return dx[:, 2 + self._N:], D, (got[0], got[1], None, None, None, d), kin + (W, bias), p
+
     def _solve(self, x, w, U, s, p=None):
         """(z_rest', D, axle forces, kinematics) of a batch of states ``x`` (b, n) and inputs ``w``
         (b, n_w): the generalized accelerations (v1', r') and the drive force D that holds u_1 (the
@@ -285,19 +318,12 @@ class NonlinearModel:
         kin = self._kinematics(x, U)
         psi, v1, r, e, n, V, u_b, v_b = kin
         a_c = self.split_input(w)[4]
-        c = self._c
         B = x.shape[0]
         if p is None:
             p = self._p.take(np.zeros(B, dtype=int))
         m = p.m
         dtype = np.result_type(x, w, float)
-        # partial velocities of the CGs: W[b, i, z, :], z = (u1, v1, r1..rN)
-        W = np.empty((B, N, N + 2, 2), dtype=dtype)
-        W[:, :, 0] = e[:, None, 0]
-        W[:, :, 1] = n[:, None, 0]
-        W[:, :, 2:] = c[None, :, :, None] * n[:, None, :, :]
-        bias = ((U * r[:, 0])[:, None] * n[:, 0] - (v1 * r[:, 0])[:, None] * e[:, 0])[:, None, :] \
-            - np.einsum("ik,bk,bkc->bic", c, r * r, e)                              # (b, N, 2)
+        W, bias = self._partials(kin, U, dtype)
         Mfull = np.einsum("bi,bizc,biyc->bzy", m, W, W)
         Mfull[:, np.arange(2, N + 2), np.arange(2, N + 2)] += p.I
         Mr = Mfull[:, 1:, 1:]
@@ -367,6 +393,23 @@ class NonlinearModel:
         TractionError
             A driven axle out of friction: the speed cannot be held.
         """
+        x2, w2, one = self._batch(x, w)
+        if x2.dtype == np.float64 and w2.dtype.kind in "fiu":
+            eq = _compiled(self)
+            if eq is not None:                          # the same equations compiled (native.py)
+                p = params if params is not None else self._p.take(np.zeros(x2.shape[0], dtype=int))
+                dx, _D, failed = eq.derivatives(x2, w2, float(speed_mps), tire_scale, p)
+                if dx is None:
+                    row, j, needed, available = failed
+                    raise TractionError(self.vehicle.axles[j].name, needed, available, row)
+                return dx[0] if one else dx
+        return self.derivatives_numpy(t, x, w, speed_mps, tire_scale, params)
+
+    def derivatives_numpy(self, t: float, x: np.ndarray, w: np.ndarray, speed_mps: float,
+                          tire_scale: float = 1.0, params: Parameters | None = None) -> np.ndarray:
+        """:meth:`derivatives` by the numpy equations (:meth:`_solve`), whatever the machine has: the
+        reference the compiled equations are tested against, and the equations of complex states
+        (:meth:`jacobian`'s complex steps)."""
         N = self._N
         x2, w2, one = self._batch(x, w)
         zr, D, _forces, (psi, v1, r, e, n, V, *_rest), _p = self._solve(x2, w2, float(speed_mps), tire_scale, params)
@@ -386,7 +429,8 @@ class NonlinearModel:
         for a batch (rows of ``x``)."""
         x2, w2, one = self._batch(np.asarray(x, dtype=float), np.asarray(w, dtype=float))
         N, U = self._N, float(speed_mps)
-        zr, D, (Fx_w, Fy_w, *_f, d), (psi, v1, r, e, n, V, u_b, v_b, W, bias), p = self._solve(x2, w2, U, tire_scale)
+        zr, D, (Fx_w, Fy_w, *_f, d), (psi, v1, r, e, n, V, u_b, v_b, W, bias), p = self._solve_outputs(x2, w2, U,
+                                                                                                      tire_scale)
         z = np.concatenate([np.zeros((x2.shape[0], 1)), zr], axis=1)     # (u1' = 0, v1', r')
         A = np.einsum("bizc,bz->bic", W, z) + bias                       # CG accelerations (ground)
         P = np.zeros((x2.shape[0], N, 2))
@@ -451,6 +495,20 @@ class NonlinearModel:
             wc[k] += 1j * h
             B[:, k] = self.derivatives(0.0, x.astype(complex), wc, speed_mps, tire_scale).imag / h
         return J, B
+
+
+_COMPILED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _compiled(model: NonlinearModel):
+    """The compiled equations of ``model`` (:mod:`lcvreport.model.nonlinear.native`), made once per
+    model; None where they are not available (the numpy equations then)."""
+    try:
+        return _COMPILED[model]
+    except KeyError:
+        from . import native
+        eq = _COMPILED[model] = native.compiled(model, DRIVE_ITERATIONS, DRIVE_RTOL)
+        return eq
 
 
 def nonlinear_model(vehicle: Vehicle, tire: str = TIRE, friction_coefficient: float = FRICTION_COEFFICIENT
