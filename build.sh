@@ -52,9 +52,9 @@ python_env() {
     fi
 }
 
-# the nonlinear model's compiled equations (lcvreport/model/nonlinear/native.py): made now, not
-# at the first command that needs them
-native() { "$PY" -m lcvreport.model.nonlinear.native >&2; }
+# the package's C sources (the nonlinear model's equations, the turn's path-following law;
+# lcvreport/util/compiled.py): compiled now, not at the first command that needs them
+native() { "$PY" -m lcvreport.util.compiled >&2; }
 
 setup() { system_packages; python_env; native; }
 

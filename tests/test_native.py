@@ -204,7 +204,7 @@ def test_the_library_is_compiled_into_the_cache_once_named_by_its_source(tmp_pat
     first = _run(PROBE, LCV_CACHE_DIR=str(tmp_path))
     assert first.returncode == 0, first.stderr
     libs = sorted(tmp_path.iterdir())
-    assert len(libs) == 1 and libs[0].name.startswith("lcv_nonlinear_") and libs[0].suffix == ".so", libs
+    assert len(libs) == 1 and libs[0].name.startswith("lcv_equations_") and libs[0].suffix == ".so", libs
     assert first.stdout.splitlines() == [f"(True, 'compiled: {libs[0]}')", "True"]
     stamp = libs[0].stat().st_mtime_ns
     again = _run(PROBE, LCV_CACHE_DIR=str(tmp_path))
@@ -217,3 +217,39 @@ def test_a_model_beyond_the_compiled_sizes_takes_the_numpy_equations(monkeypatch
     m = nonlinear_model(load_preset("aucnat"))
     assert native.compiled(m, 60, 1e-13) is None
     assert np.all(m.derivatives(0.0, np.zeros(m.n_states), m.zero_input(), 20.0)[2:] == 0.0)
+
+
+@pytest.mark.parametrize("angle_deg", [90.0, 180.0, 1440.0])
+def test_the_compiled_path_following_law_is_the_numpy_law(angle_deg):
+    """The turn's steer law (friction_demand.PathFollowing; path_following.c): the outside wheel's
+    arc length, path error and the steer of states all over the turn's ground -- the approach, the
+    arc's laps, the exit, the corners -- are numpy's bit for bit (the same operations in the same
+    order, libm's sin/cos/atan2/hypot as numpy's)."""
+    from lcvreport.measures.friction_demand import turn_with_tire_forces
+    follow = turn_with_tire_forces(load_vehicle(EXAMPLES / "b_double.toml"), angle_deg=90.0).follow
+    follow = _with_angle(follow, angle_deg)
+    assert follow._compiled is not None
+    rng = np.random.default_rng(11)
+    k = 4000
+    X = np.zeros((len(follow.state_names), k))
+    X[0], X[1] = rng.uniform(-30.0, 40.0, k), rng.uniform(-40.0, 15.0, k)
+    X[2] = rng.uniform(-9.0, 1.0, k)
+    X[-1] = rng.normal(size=k)
+    t = rng.uniform(0.0, 1.2 * follow.path.s_end / follow.U, k)
+    for got, ref in zip(follow._compiled(t, X), follow.law_numpy(t, X)):
+        assert np.array_equal(got, ref)
+
+
+def _with_angle(follow, angle_deg):
+    """``follow`` on a path of ``angle_deg`` (its delta_kin table kept: the law's arithmetic is
+    what is compared, not the turn)."""
+    import copy
+    import math
+
+    from lcvreport.manoeuvres.paths import StraightArcPath
+    from lcvreport.measures import friction_demand
+    other = copy.copy(follow)
+    p = follow.path
+    other.path = StraightArcPath(p.radius_m, math.radians(angle_deg), p.exit_m)
+    other._compiled = friction_demand._compiled_law(other)
+    return other

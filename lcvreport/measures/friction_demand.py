@@ -33,8 +33,10 @@ Examples
 from __future__ import annotations
 
 import copy
+import ctypes
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -45,6 +47,7 @@ from ..model.vehicle import Vehicle
 from ..units import kph_to_mps
 from .low_speed import ANGLE_DEG, RADIUS_M, LowSpeedTurn, low_speed_turn, turn_of_run
 from ..util.cache import LRUCache
+from ..util.compiled import load
 from ..util.threads import one_blas_thread
 from .registry import MeasureCase
 
@@ -134,6 +137,14 @@ class PathFollowing:
         self._s_grid = grid
         self._delta_kin = tangent - kinematic_run.headings(grid)[:, 0]            # left positive
         self._memo = (None, None, None)
+        self._compiled = _compiled_law(self)
+
+    def __getstate__(self):                  # the compiled law is this process's (ctypes)
+        return {**self.__dict__, "_compiled": None}
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._compiled = _compiled_law(self)
 
     @property
     def state_names(self) -> tuple:
@@ -156,20 +167,36 @@ class PathFollowing:
     def error(self, t, X) -> tuple[np.ndarray, np.ndarray]:
         """(s, e) [m] of the outside steer wheel of the states ``X`` (columns) at times ``t``
         (the last call's remembered: the law and the equations ask for the same states)."""
+        return self._law(t, X)[:2]
+
+    def _law(self, t, X) -> tuple:
+        """(s, e, delta) of :meth:`error` and the steer, by the compiled law where this machine
+        has it (path_following.c), the same arithmetic in numpy otherwise; the last call's
+        remembered."""
         X = np.asarray(X, dtype=float)
-        key = (np.asarray(t, dtype=float).tobytes(), X.tobytes())
+        t = np.asarray(t, dtype=float)
+        key = (t.tobytes(), X.tobytes())
         if self._memo[0] == key:
-            return self._memo[1], self._memo[2]
+            return self._memo[1]
+        if self._compiled is not None and X.ndim == 2:
+            out = self._compiled(np.broadcast_to(t, X.shape[1:]), X)
+        else:
+            out = self.law_numpy(t, X)
+        self._memo = (key, out)
+        return out
+
+    def law_numpy(self, t, X) -> tuple:
+        """(s, e, delta) of the states ``X`` (columns) at times ``t`` by numpy: the outside steer
+        wheel's arc length and path error [m] and the steer [rad] (the compiled law's reference)."""
+        X = np.asarray(X, dtype=float)
         Xw, Yw = self.wheel(X)
         s, e = path_coordinates(self.path, Xw, Yw, self.U * np.asarray(t, dtype=float))
-        self._memo = (key, s, e)
-        return s, e
+        delta_kin = np.interp(s, self._s_grid, self._delta_kin)        # clamped to the run's ends
+        return s, e, -delta_kin + self.K * e + self.K_I * X[-1]
 
     def __call__(self, t, X) -> np.ndarray:
         """The steer [rad, the model's sign: nose right positive] of the states ``X`` (n, k)."""
-        s, e = self.error(t, X)
-        delta_kin = np.interp(s, self._s_grid, self._delta_kin)        # clamped to the run's ends
-        return -delta_kin + self.K * e + self.K_I * np.asarray(X)[-1]
+        return self._law(t, X)[2]
 
     def lost(self, t, z) -> float:
         """Positive while the outside steer wheel is within :data:`LOST_PATH_M` of its path
@@ -421,6 +448,42 @@ def prefetch_cases(vehicles, tire_scales, keys, conditions: dict | None = None) 
         prefetch_turns(group, case.condition("turn_radius_m"), case.condition("turn_angle_deg"),
                        case.condition("turn_speed_kph"), case.condition("friction_coefficient"),
                        case.condition("path_gain_rad_per_m"), tire_scale=ts)
+
+
+class _Law(ctypes.Structure):
+    _fields_ = [(k, ctypes.c_double) for k in ("R", "a", "arc_end", "x_m", "half_track", "K", "K_I", "U")] + \
+        [("G", ctypes.c_longlong), ("grid", ctypes.c_void_p), ("dk", ctypes.c_void_p)]
+
+
+_LAW_SOURCE = Path(__file__).with_name("path_following.c")
+
+
+def _compiled_law(follow: PathFollowing):
+    """The compiled path-following law of ``follow`` (path_following.c, :mod:`lcvreport.util.compiled`):
+    a function (t (k,), X (n, k)) -> (s, e, delta), or None (no library, or a path that is not a
+    straight-arc-straight one: the numpy law then)."""
+    from ..manoeuvres.paths import StraightArcPath
+    if type(follow.path) is not StraightArcPath:
+        return None
+    lib, _why = load(_LAW_SOURCE, {"lcv_path_following": (None, [
+        ctypes.POINTER(_Law), ctypes.c_longlong, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_void_p,
+        ctypes.c_void_p, ctypes.c_void_p])})
+    if lib is None:
+        return None
+    p = follow.path
+    grid, dk = np.ascontiguousarray(follow._s_grid, dtype=float), np.ascontiguousarray(follow._delta_kin, dtype=float)
+    law = _Law(float(p.radius_m), float(p.angle_rad), float(p.arc_end_s), follow.x_m, follow.half_track_m, follow.K,
+               follow.K_I, follow.U, grid.size, grid.ctypes.data, dk.ctypes.data)
+    f = lib.lcv_path_following
+
+    def call(t, X, keep=(grid, dk, law)):
+        rows = np.ascontiguousarray(X.T)
+        k, n = rows.shape
+        t = np.ascontiguousarray(t, dtype=float)
+        s, e, delta = np.empty(k), np.empty(k), np.empty(k)
+        f(ctypes.byref(law), k, t.ctypes.data, rows.ctypes.data, n, s.ctypes.data, e.ctypes.data, delta.ctypes.data)
+        return s, e, delta
+    return call
 
 
 @one_blas_thread

@@ -1,15 +1,13 @@
 """The nonlinear model's equations compiled (``equations.c`` beside this module): the same
 arithmetic as :meth:`NonlinearModel._solve <lcvreport.model.nonlinear.model.NonlinearModel>` one
-state at a time, ~100x faster than numpy's per call, so that an integration's cost is its steps,
-not the interpreter (docs/nonlinear.md#integration).
+state at a time: a call ~6x cheaper than numpy's (what is left is the call's own Python), so
+that an integration's cost is its steps, not the interpreter (docs/nonlinear.md#integration).
 
-The library is compiled with the machine's C compiler (``cc``, else ``gcc``) the first time it is
-needed and kept in the user's cache (``$LCV_CACHE_DIR``, else ``$XDG_CACHE_HOME/lcvreport``, else
-``~/.cache/lcvreport``), named by the hash of its source and flags: a changed source is a new
-library, never a stale one.  ``./build.sh`` compiles it at set-up.  Where no compiler or no
-writable cache is found, or ``LCV_NATIVE=0``, the numpy equations are used (:func:`status` says
-which and why): the same equations, numbers that differ in rounding only (tests/test_native.py
-holds the two to 1e-12).
+The library is compiled and cached by :mod:`lcvreport.util.compiled` (the machine's C compiler,
+the user's cache, ``./build.sh`` at set-up).  Where it cannot be had, or ``LCV_NATIVE=0``, the
+numpy equations are used (:func:`status` says which and why): the same equations, numbers that
+differ in rounding only (tests/test_native.py holds the two to 8 eps times the mass matrix's
+condition number).
 
 Examples
 --------
@@ -20,22 +18,15 @@ True
 from __future__ import annotations
 
 import ctypes
-import hashlib
-import os
-import shutil
-import subprocess
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ...util.compiled import load
+
 SOURCE = Path(__file__).with_name("equations.c")
-#: the compiler's flags: optimized, no fused multiply-add (the source's rounding), position-independent
-FLAGS = ("-O2", "-ffp-contract=off", "-fno-fast-math", "-shared", "-fPIC")
 #: the model sizes the compiled equations take (units, axles)
 NMAX, AMAX = 16, 64
-
-_state: dict = {}
 
 
 class _Model(ctypes.Structure):
@@ -54,82 +45,19 @@ class _Failure(ctypes.Structure):
                 ("available", ctypes.c_double)]
 
 
-def cache_dir() -> Path:
-    """Where the compiled library is kept (see the module docstring)."""
-    if os.environ.get("LCV_CACHE_DIR"):
-        return Path(os.environ["LCV_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "lcvreport"
-
-
-def _compiler() -> str | None:
-    for name in (os.environ.get("CC"), "cc", "gcc"):
-        if name and shutil.which(name):
-            return shutil.which(name)
-    return None
-
-
-def _library_path() -> Path:
-    digest = hashlib.sha256(SOURCE.read_bytes() + " ".join(FLAGS).encode()).hexdigest()[:16]
-    return cache_dir() / f"lcv_nonlinear_{digest}.so"
-
-
-def _build(target: Path) -> str | None:
-    """Compile the source to ``target`` (atomically: a concurrent process finds a whole library or
-    none); the reason it could not, or None."""
-    cc = _compiler()
-    if cc is None:
-        return "no C compiler (cc, gcc) on PATH"
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
-        os.close(fd)
-    except OSError as exc:
-        return f"the cache {target.parent} is not writable ({exc.strerror})"
-    try:
-        done = subprocess.run([cc, *FLAGS, "-o", tmp, str(SOURCE), "-lm"], capture_output=True, text=True,
-                              timeout=120)
-        if done.returncode != 0:
-            return f"{cc} failed: {done.stderr.strip().splitlines()[-1] if done.stderr.strip() else done.returncode}"
-        os.replace(tmp, target)
-        return None
-    except (OSError, subprocess.SubprocessError) as exc:
-        return f"{cc} could not run ({exc})"
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-
-
 def library():
     """The compiled equations (a ctypes library), compiled if needed; None where they cannot be
     (:func:`status`)."""
-    if "lib" in _state:
-        return _state["lib"]
-    lib, why = None, None
-    if os.environ.get("LCV_NATIVE", "1") == "0":
-        why = "LCV_NATIVE=0"
-    else:
-        path = _library_path()
-        if not path.exists():
-            why = _build(path)
-        if why is None:
-            try:
-                lib = ctypes.CDLL(str(path))
-                f = lib.lcv_nonlinear_derivatives
-                f.restype = ctypes.c_int
-                f.argtypes = [ctypes.POINTER(_Model), ctypes.POINTER(_Params), ctypes.c_longlong, ctypes.c_void_p,
-                              ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p,
-                              ctypes.c_void_p, ctypes.POINTER(_Failure)]
-            except OSError as exc:
-                lib, why = None, f"{path} could not be loaded ({exc})"
-    _state["lib"], _state["why"] = lib, why or f"compiled: {_library_path()}"
-    return lib
+    return load(SOURCE, {"lcv_nonlinear_derivatives": (ctypes.c_int, [
+        ctypes.POINTER(_Model), ctypes.POINTER(_Params), ctypes.c_longlong, ctypes.c_void_p, ctypes.c_void_p,
+        ctypes.c_double, ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
+        ctypes.POINTER(_Failure)])})[0]
 
 
 def status() -> tuple[bool, str]:
     """(whether the compiled equations are used, where they are or why not)."""
     lib = library()
-    return lib is not None, _state["why"]
+    return lib is not None, load(SOURCE)[1]
 
 
 class CompiledEquations:
