@@ -253,3 +253,12 @@ def _with_angle(follow, angle_deg):
     other.path = StraightArcPath(p.radius_m, math.radians(angle_deg), p.exit_m)
     other._compiled = friction_demand._compiled_law(other)
     return other
+
+
+@pytest.mark.parametrize("module", ["lcvreport.util.compiled", "lcvreport.model.nonlinear.native"])
+def test_the_compile_commands_refuse_an_argument_in_one_line(module):
+    bad = subprocess.run([sys.executable, "-m", module, "--bogus"], capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and bad.stdout == ""
+    assert bad.stderr == f"python -m {module}: takes no argument, got '--bogus'\n"
+    good = subprocess.run([sys.executable, "-m", module, "--help"], capture_output=True, text=True, timeout=300)
+    assert good.returncode == 0 and good.stdout.startswith(f"usage: python -m {module}\n")

@@ -108,9 +108,17 @@ def load(source: Path, signatures: dict | None = None) -> tuple:
     return lib, why
 
 
-def main() -> int:
+def main(argv=None) -> int:
     """``python -m lcvreport.util.compiled``: compile (if needed) every C source of the package and
-    say where each is, or why not (``./build.sh`` set-up)."""
+    say where each is, or why not (``./build.sh`` set-up).  Takes no argument (``--help``: this)."""
+    import sys
+    argv = sys.argv[1:] if argv is None else argv
+    if argv in (["-h"], ["--help"]):
+        print("usage: python -m lcvreport.util.compiled\n" + " ".join(line.strip() for line in (main.__doc__ or "").split("\n\n")[0].split("\n")))
+        return 0
+    if argv:
+        print(f"python -m lcvreport.util.compiled: takes no argument, got {argv[0]!r}", file=sys.stderr)
+        return 2
     for source in sorted(Path(__file__).resolve().parents[1].rglob("*.c")):
         print(f"{source.name}: {load(source)[1]}")
     return 0

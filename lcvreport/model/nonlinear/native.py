@@ -111,8 +111,17 @@ def compiled(model, iterations: int, rtol: float) -> CompiledEquations | None:
     return None if lib is None else CompiledEquations(model, lib, iterations, rtol)
 
 
-def main() -> int:
-    """``python -m lcvreport.model.nonlinear.native``: compile (if needed) and say where, or why not."""
+def main(argv=None) -> int:
+    """``python -m lcvreport.model.nonlinear.native``: compile (if needed) and say where, or why not.
+    Takes no argument (``--help``: this)."""
+    import sys
+    argv = sys.argv[1:] if argv is None else argv
+    if argv in (["-h"], ["--help"]):
+        print("usage: python -m lcvreport.model.nonlinear.native\n" + " ".join(line.strip() for line in (main.__doc__ or "").split("\n\n")[0].split("\n")))
+        return 0
+    if argv:
+        print(f"python -m lcvreport.model.nonlinear.native: takes no argument, got {argv[0]!r}", file=sys.stderr)
+        return 2
     ok, why = status()
     print(("compiled equations: " if ok else "numpy equations: ") + why)
     return 0
