@@ -108,17 +108,26 @@ def load(source: Path, signatures: dict | None = None) -> tuple:
     return lib, why
 
 
-def main(argv=None) -> int:
-    """``python -m lcvreport.util.compiled``: compile (if needed) every C source of the package and
-    say where each is, or why not (``./build.sh`` set-up).  Takes no argument (``--help``: this)."""
+def command_line(prog: str, doc: str, argv=None) -> int | None:
+    """The argument check of a command that takes none (``python -m <prog>``): the exit status
+    (0 after ``--help``, 2 after one line naming an argument), or None to go on."""
     import sys
     argv = sys.argv[1:] if argv is None else argv
     if argv in (["-h"], ["--help"]):
-        print("usage: python -m lcvreport.util.compiled\n" + " ".join(line.strip() for line in (main.__doc__ or "").split("\n\n")[0].split("\n")))
+        print(f"usage: python -m {prog}\n" + " ".join(line.strip() for line in doc.split("\n\n")[0].split("\n")))
         return 0
     if argv:
-        print(f"python -m lcvreport.util.compiled: takes no argument, got {argv[0]!r}", file=sys.stderr)
+        print(f"python -m {prog}: takes no argument, got {argv[0]!r}", file=sys.stderr)
         return 2
+    return None
+
+
+def main(argv=None) -> int:
+    """``python -m lcvreport.util.compiled``: compile (if needed) every C source of the package and
+    say where each is, or why not (``./build.sh`` set-up).  Takes no argument (``--help``: this)."""
+    status = command_line("lcvreport.util.compiled", main.__doc__ or "", argv)
+    if status is not None:
+        return status
     for source in sorted(Path(__file__).resolve().parents[1].rglob("*.c")):
         print(f"{source.name}: {load(source)[1]}")
     return 0

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...util.compiled import load
+from ...util.compiled import command_line, load
 
 SOURCE = Path(__file__).with_name("equations.c")
 #: the model sizes the compiled equations take (units, axles)
@@ -114,14 +114,9 @@ def compiled(model, iterations: int, rtol: float) -> CompiledEquations | None:
 def main(argv=None) -> int:
     """``python -m lcvreport.model.nonlinear.native``: compile (if needed) and say where, or why not.
     Takes no argument (``--help``: this)."""
-    import sys
-    argv = sys.argv[1:] if argv is None else argv
-    if argv in (["-h"], ["--help"]):
-        print("usage: python -m lcvreport.model.nonlinear.native\n" + " ".join(line.strip() for line in (main.__doc__ or "").split("\n\n")[0].split("\n")))
-        return 0
-    if argv:
-        print(f"python -m lcvreport.model.nonlinear.native: takes no argument, got {argv[0]!r}", file=sys.stderr)
-        return 2
+    status_ = command_line("lcvreport.model.nonlinear.native", main.__doc__ or "", argv)
+    if status_ is not None:
+        return status_
     ok, why = status()
     print(("compiled equations: " if ok else "numpy equations: ") + why)
     return 0
