@@ -26,7 +26,7 @@ import pytest
 from lcvreport.fmu.interface import vehicle_interface
 from lcvreport.model.presets import PRESETS
 from lcvreport.model.vehicle_file import load_vehicle
-from lcvreport.report.notebooks import NOTEBOOKS, SPECS, ReportError, execute, overfull_boxes
+from lcvreport.report.notebooks import NOTEBOOKS, SPECS, ReportError, execute, kernel_options, overfull_boxes
 
 from conftest import ASSESSMENTS, EXAMPLES, MOUNTED, ROOT, TRACKING_STATS, build_thesis_report as _build
 from helpers import with_default_sigint
@@ -206,10 +206,47 @@ def test_papermill_run_directly_stops_at_the_check_with_the_parameter_named(tmp_
     with pytest.raises(pm.PapermillExecutionError, match="parameter preset"):
         pm.execute_notebook(str(ROOT / "notebooks" / "ch4_triple.ipynb"), str(tmp_path / "out.ipynb"),
                             parameters={"preset": "aucant", "fast": True, "data_dir": str(tmp_path)},
-                            kernel_name="python3", cwd=str(tmp_path), progress_bar=False)
+                            kernel_name="python3", cwd=str(tmp_path), progress_bar=False, **kernel_options())
     nb = nbformat.read(tmp_path / "out.ipynb", as_version=4)
     shown = [o for c in nb.cells for o in c.get("outputs", []) if o.get("output_type") == "display_data"]
     assert not shown                                           # nothing computed before the refusal
+
+
+def test_each_kernel_has_its_own_unix_sockets():
+    """The report's kernels start on Unix sockets named by a random token: two kernels
+    started at once cannot take each other's address (on TCP a port picked free could be
+    bound by another kernel first: ``Address already in use``, a report failed by timing)."""
+    managers = [kernel_options()["kernel_manager_class"](kernel_name="python3") for _ in range(2)]
+    assert [m.transport for m in managers] == ["ipc", "ipc"]
+    assert managers[0].ip != managers[1].ip
+    assert all(Path(m.ip).parent.is_dir() and len(m.ip) <= 96 for m in managers)
+
+
+def test_a_temporary_folder_too_long_for_a_socket_keeps_tcp(monkeypatch, tmp_path):
+    import tempfile
+    monkeypatch.setattr(tempfile, "gettempdir", lambda: str(tmp_path / ("x" * 100)))
+    assert kernel_options() == {"extra_arguments": ["--IPKernelApp.log_level=CRITICAL"]}
+
+
+def test_kernels_started_together_all_run(tmp_path):
+    """Four notebooks executed at once on four threads (what the report's build does) all run."""
+    from concurrent.futures import ThreadPoolExecutor
+    import papermill as pm
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("x = 6 * 7\nprint(x)")])
+    nbformat.write(nb, tmp_path / "tiny.ipynb")
+
+    options = [kernel_options() for _ in range(4)]
+    sockets = [Path(o["kernel_manager_class"](kernel_name="python3").ip) for o in options]
+
+    def run(i):
+        out = tmp_path / f"out{i}.ipynb"
+        pm.execute_notebook(str(tmp_path / "tiny.ipynb"), str(out), kernel_name="python3", cwd=str(tmp_path),
+                            progress_bar=False, **options[i])
+        return nbformat.read(out, as_version=4).cells[0].outputs[0]["text"]
+
+    with ThreadPoolExecutor(4) as pool:
+        assert list(pool.map(run, range(4))) == ["42\n"] * 4
+    assert not [p for s in sockets for p in s.parent.glob(s.name + "-*")]     # removed at each kernel's shutdown
 
 
 def _markdown_outputs(path: Path) -> str:
@@ -240,7 +277,7 @@ def test_relative_data_dir_is_resolved_against_the_run_folder(tmp_path):
     work.mkdir()
     pm.execute_notebook(str(ROOT / "notebooks" / "appendices.ipynb"), str(work / "out.ipynb"),
                         parameters={"fast": True, "data_dir": "csv"}, kernel_name="python3", cwd=str(work),
-                        progress_bar=False)
+                        progress_bar=False, **kernel_options())
     assert sorted(p.name for p in (work / "csv").iterdir())[:1] == ["figure_D_1.csv"]
     assert not (ROOT / "notebooks" / "csv").exists()
 

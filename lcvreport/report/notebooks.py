@@ -30,8 +30,40 @@ TRIPLES = PRESETS[:5]
 HTML_ONLY = "lcv-html-only"
 
 
-#: the kernel logs errors only (its TCP-on-localhost warning is not the reader's concern)
+#: the kernel logs errors only
 KERNEL_ARGS = ["--IPKernelApp.log_level=CRITICAL"]
+
+
+def kernel_options() -> dict:
+    """The notebook client's options that start each kernel on its own Unix sockets.
+
+    On TCP, jupyter_client picks a free port, releases it and the kernel binds it later: a
+    kernel started meanwhile (the report's notebooks run in parallel, other processes run
+    theirs) can take the port first, and the report failed with ``Address already in use``.
+    Unix sockets named by a random token in the temporary folder cannot collide.  Where the
+    socket path would exceed the system's limit (a long ``TMPDIR``), the client's TCP default
+    stays."""
+    import os
+    import tempfile
+    import uuid
+    base = os.path.join(tempfile.gettempdir(), f"lcv-kernel-{uuid.uuid4().hex[:16]}")
+    if os.name != "posix" or len(base) > 96:          # sun_path holds 108 bytes; "-5" and NUL follow
+        return {"extra_arguments": KERNEL_ARGS}
+    return {"extra_arguments": KERNEL_ARGS, "kernel_manager_class": _ipc_kernel_manager(base)}
+
+
+def _ipc_kernel_manager(base: str):
+    from jupyter_client import AsyncKernelManager
+
+    class IpcKernelManager(AsyncKernelManager):
+        """A kernel on Unix sockets ``<base>-1`` ... ``<base>-5`` (removed at its shutdown)."""
+
+        def __init__(self, **kwargs):
+            kwargs.setdefault("transport", "ipc")
+            kwargs.setdefault("ip", base)
+            super().__init__(**kwargs)
+
+    return IpcKernelManager
 
 
 #: paper sizes of the PDF (LaTeX geometry names)
@@ -317,7 +349,7 @@ def execute(stem: str, out_dir: Path, parameters: dict, source_dir: Path | None 
     dst = out_dir / f"{stem}.ipynb"
     try:
         pm.execute_notebook(str(src), str(dst), parameters=parameters, kernel_name="python3",
-                            cwd=str(out_dir), progress_bar=False, log_output=False, extra_arguments=KERNEL_ARGS)
+                            cwd=str(out_dir), progress_bar=False, log_output=False, **kernel_options())
     except pm.PapermillExecutionError as exc:
         if exc.ename == "KeyboardInterrupt":     # Ctrl-C reached the kernel too: an interruption, not a failure
             raise KeyboardInterrupt from None
@@ -480,7 +512,7 @@ def execute_unchecked(stem, nb_dir, params, src):
     dst = nb_dir / f"{stem}.ipynb"
     try:
         pm.execute_notebook(str(src / f"{stem}.ipynb"), str(dst), parameters=params, kernel_name="python3",
-                            cwd=str(nb_dir), progress_bar=False, log_output=False, extra_arguments=KERNEL_ARGS)
+                            cwd=str(nb_dir), progress_bar=False, log_output=False, **kernel_options())
     except pm.PapermillExecutionError as exc:
         where = _failed_cell(src / f"{stem}.ipynb", dst, exc.cell_index)
         raise ReportError(f"notebook {stem}.ipynb failed in {where}: {exc.ename}: {exc.evalue} "
