@@ -225,3 +225,79 @@ def test_the_law_holds_the_path_and_the_turns_tolerance_is_the_strict_ones():
     assert fast.stfd is None and fast.friction_demand_drive is None and fast.turn is None
     assert fast.path_error_max_m >= LOST_PATH_M and "left the path" in fast.undefined["stfd"]
     assert fast.response.stopped_at is not None and fast.response.time[-1] <= fast.response.stopped_at
+
+
+def test_on_a_path_that_comes_back_over_itself_the_heading_places_the_point():
+    """A full circle's exit runs over its approach and its laps coincide: a point near the start
+    is on the approach while the heading is the approach's, on the exit after the lap; on a
+    four-lap arc the lap is the heading's (the turn's law reads unit 1's heading, unwrapped)."""
+    from lcvreport.manoeuvres.paths import StraightArcPath
+    from lcvreport.measures.friction_demand import path_coordinates
+    R = 12.5
+    lap = StraightArcPath(R, 2 * math.pi, 20.0)
+    assert path_coordinates(lap, -1.0, 0.2, heading_rad=0.0) == (-1.0, 0.2)
+    s, e = path_coordinates(lap, 1.0, 0.2, heading_rad=2 * math.pi)
+    assert (s, e) == (pytest.approx(2 * math.pi * R + 1.0, abs=1e-12), pytest.approx(0.2, abs=1e-12))
+    s, e = path_coordinates(lap, 1.0, 0.2, heading_rad=0.1)           # just into the arc: its first lap
+    assert s == pytest.approx(R * math.atan2(1.0, R - 0.2), abs=1e-12) and e == pytest.approx(R - math.hypot(1.0, R - 0.2))
+    four = StraightArcPath(R, 8 * math.pi, 20.0)
+    X, Y = R * math.sin(1.0), R * (1 - math.cos(1.0))                  # on the circle at 1 rad
+    for k in range(4):
+        s, e = path_coordinates(four, X, Y, heading_rad=1.0 + 2 * math.pi * k + 0.4)   # the heading a little off
+        assert s == pytest.approx(R * (1.0 + 2 * math.pi * k), abs=1e-9) and abs(e) < 1e-12
+    # without a heading, every piece counts (a path that does not come back over itself needs none)
+    quarter = StraightArcPath(R, math.pi / 2, 20.0)
+    assert path_coordinates(quarter, R + 0.3, R + 5.0) == (pytest.approx(R * math.pi / 2 + 5.0), pytest.approx(-0.3))   # right of it
+
+
+def test_a_long_turn_settles_on_the_steady_circle_of_its_radius():
+    """Four laps (1440 deg) of the tractor-semitrailer with tire forces: on the last lap the run
+    is the steady circle a root finder gives from the Newton-Euler equations (tests/test_nonlinear.py)
+    with the outside steer wheel at the turn's radius -- every unit at one yaw rate, unit 1's
+    lateral velocity, the articulation and the steer.  (The run once stopped at its start: the
+    exit of a turn past 360 deg runs over the approach and the law took the exit for the place.)"""
+    from scipy.optimize import fsolve
+    from test_nonlinear import newton_euler
+    from lcvreport.measures.friction_demand import TURN_RTOL
+    from lcvreport.model.presets import load_preset
+    v = load_preset("tractor_semitrailer")
+    N, R = v.n_units, 12.5
+    t = turn_with_tire_forces(v, radius_m=R, angle_deg=1440.0)
+    assert t.stfd is not None and t.path_error_max_m < 0.05
+    r, follow = t.response, t.follow
+    U = r.speed_mps
+    heading = -r.state_at(r.time)[:, 2]
+    tk = float(np.interp(7 * math.pi, heading, r.time))                # three and a half laps into the arc
+    x_run = r.state_at([tk])[0]
+    delta_run = float(follow(np.array([tk]), x_run[:, None])[0])
+    steer = next(a for a in v.units[0].axles if a.steered)
+    m = nonlinear_model(v)
+
+    def steady(p):                           # p = [v1, Omega, theta_1..theta_(N-1), delta]
+        v1, omega, theta, delta = p[0], p[1], p[2:N + 1], p[N + 1]
+        x = np.r_[0.0, 0.0, -np.r_[0.0, np.cumsum(theta)], v1, np.full(N, omega)]
+        w = m.zero_input()
+        w[0] = delta
+        xd, _D = newton_euler(v, x, w, U)
+        xc, yc = -v1 / omega, U / omega      # the centre of the turn in unit 1's axes (x forward, y right)
+        radius = math.hypot(steer.x_m - xc, steer.track_width_m / 2 - yc)
+        return np.r_[xd[2 + N], xd[3 + N:], radius - R]
+
+    guess = np.r_[x_run[2 + N], x_run[3 + N], -np.diff(x_run[2:2 + N]), delta_run]
+    p = fsolve(steady, guess, xtol=1e-13)
+    assert np.abs(steady(p)).max() < 1e-9
+    got = np.r_[x_run[2 + N], x_run[3 + N:3 + 2 * N], -np.diff(x_run[2:2 + N]), delta_run]
+    ref = np.r_[p[0], np.full(N, p[1]), p[2:N + 1], p[N + 1]]
+    assert np.abs(got - ref).max() <= TURN_RTOL * np.abs(ref).max()     # measured 1.8e-6 of each
+
+
+def test_a_b_double_past_three_quarter_turns_is_refused_by_its_traction():
+    """At 12.5 m the B-double's rear trailer winds in towards a jackknife (the kinematic turn
+    reaches 95 deg of articulation at 300 deg); with tire forces the drive axle cannot pull it
+    round past ~265 deg: the run stops naming the axle and the time, and the registry's family
+    gives no friction demand with that reason -- never a number, never the run stuck at its start."""
+    from lcvreport.analysis.integrate import IntegrationError
+    v = load_vehicle(EXAMPLES / "b_double.toml")
+    with pytest.raises(IntegrationError, match=r"at t = 3\d\.\d+ s: driven axle drive1 needs .* the speed cannot be held"):
+        turn_with_tire_forces(v, angle_deg=360.0)
+    assert turn_with_tire_forces(v, angle_deg=250.0).stfd is not None

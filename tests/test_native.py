@@ -219,7 +219,7 @@ def test_a_model_beyond_the_compiled_sizes_takes_the_numpy_equations(monkeypatch
     assert np.all(m.derivatives(0.0, np.zeros(m.n_states), m.zero_input(), 20.0)[2:] == 0.0)
 
 
-@pytest.mark.parametrize("angle_deg", [90.0, 180.0, 1440.0])
+@pytest.mark.parametrize("angle_deg", [90.0, 180.0, 270.0, 360.0, 1440.0])
 def test_the_compiled_path_following_law_is_the_numpy_law(angle_deg):
     """The turn's steer law (friction_demand.PathFollowing; path_following.c): the outside wheel's
     arc length, path error and the steer of states all over the turn's ground -- the approach, the

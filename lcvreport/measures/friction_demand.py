@@ -70,13 +70,21 @@ SAMPLES_PER_M = 10.0
 KEYS = ("stfd", "friction_demand_drive", "path_error_max_m")
 
 
-def path_coordinates(path, X, Y, s_hint=0.0) -> tuple[np.ndarray, np.ndarray]:
+def path_coordinates(path, X, Y, s_hint=None, heading_rad=None) -> tuple[np.ndarray, np.ndarray]:
     """(s, e) of points (X, Y) [m] in the kinematic frame (X forward, Y left) on the
     straight-arc-straight ``path``: the arc length of each point's nearest point on the path [m]
     and its signed distance from it, positive to the left of the path's direction [m].  Of the
-    approach, the arc and the exit, the nearest that the point projects onto; on an arc of more
-    than a lap the lap nearest ``s_hint`` [m] (where the point is expected).  Scalars or arrays
+    approach, the arc and the exit, the nearest that the point projects onto.  Scalars or arrays
     of one shape.
+
+    Where the path comes back over itself (an arc of 270 degrees or more: its exit crosses or
+    runs along the approach and the arc's laps coincide) the point's place on the path is
+    ambiguous; ``heading_rad`` [rad, left positive, unwrapped: 2 pi after a lap], the direction
+    of travel there, resolves it: the arc's lap is the one nearest the heading, and the approach
+    and the exit count only while the heading is within a quarter turn of their direction (the
+    approach's 0, the exit's ``path.angle_rad``).  ``s_hint`` [m], where the point is expected
+    along the path, gives the heading ``clip(s_hint, 0, arc end) / R`` where ``heading_rad`` is
+    not given; with neither, every piece counts and the arc's first lap is taken.
 
     Examples
     --------
@@ -85,17 +93,30 @@ def path_coordinates(path, X, Y, s_hint=0.0) -> tuple[np.ndarray, np.ndarray]:
     >>> s, e = path_coordinates(p, 12.0 * math.sin(0.5), 12.5 - 12.0 * math.cos(0.5))
     >>> round(float(s), 6), round(float(e), 6)              # half a metre inside the arc at 0.5 rad
     (6.25, 0.5)
+    >>> lap = StraightArcPath(12.5, 2 * math.pi, 20.0)       # a full circle: the exit runs over the approach
+    >>> [round(float(v), 6) for v in path_coordinates(lap, -1.0, 0.2, heading_rad=0.0)]
+    [-1.0, 0.2]
+    >>> [round(float(v), 6) for v in path_coordinates(lap, 1.0, 0.2, heading_rad=2 * math.pi)]
+    [79.539816, 0.2]
     """
     X, Y = np.broadcast_arrays(np.asarray(X, dtype=float), np.asarray(Y, dtype=float))
-    hint = np.broadcast_to(np.asarray(s_hint, dtype=float), X.shape)
     R, a = path.radius_m, path.angle_rad
+    if heading_rad is not None:
+        h = np.broadcast_to(np.asarray(heading_rad, dtype=float), X.shape)
+    elif s_hint is not None:
+        h = np.clip(np.broadcast_to(np.asarray(s_hint, dtype=float), X.shape), 0.0, path.arc_end_s) / R
+    else:
+        h = None
     Cx, Cy = float(path.centre[0]), float(path.centre[1])
     inf = np.full(X.shape, np.inf)
+    approach = np.ones(X.shape, bool) if h is None else h < 0.5 * math.pi
+    leaving = np.ones(X.shape, bool) if h is None else h > a - 0.5 * math.pi
     # the approach (s <= 0)
-    d0 = np.where(X <= 0.0, np.abs(Y), inf)
-    # the arc: the angle from its start about the centre, on the lap nearest the hint
+    d0 = np.where((X <= 0.0) & approach, np.abs(Y), inf)
+    # the arc: the angle from its start about the centre, on the lap nearest the heading
     phi = np.arctan2(X - Cx, -(Y - Cy))
-    phi = phi + 2 * math.pi * np.round((np.clip(hint, 0.0, path.arc_end_s) / R - phi) / (2 * math.pi))
+    if h is not None:
+        phi = phi + 2 * math.pi * np.round((np.clip(h, 0.0, a) - phi) / (2 * math.pi))
     r = np.hypot(X - Cx, Y - Cy)
     d1 = np.where((phi >= 0.0) & (phi <= a), np.abs(R - r), inf)
     # the exit straight
@@ -103,10 +124,10 @@ def path_coordinates(path, X, Y, s_hint=0.0) -> tuple[np.ndarray, np.ndarray]:
     tx, ty = math.cos(a), math.sin(a)
     along = (X - ex) * tx + (Y - ey) * ty
     e2 = tx * (Y - ey) - ty * (X - ex)
-    d2 = np.where(along >= 0.0, np.abs(e2), inf)
+    d2 = np.where((along >= 0.0) & leaving, np.abs(e2), inf)
     # nearest to neither piece's interior: the corner points (the arc's ends)
     dc0, dc1 = np.hypot(X, Y), np.hypot(X - ex, Y - ey)
-    d = np.stack([d0, d1, d2, dc0, dc1])
+    d = np.stack([d0, d1, d2, np.where(approach, dc0, inf), np.where(leaving, dc1, inf)])
     s = np.stack([X, R * phi, path.arc_end_s + along, np.zeros(X.shape), np.full(X.shape, path.arc_end_s)])
     e = np.stack([Y, R - r, e2, dc0, dc1])
     k = np.argmin(d, axis=0)[None]
@@ -190,7 +211,7 @@ class PathFollowing:
         wheel's arc length and path error [m] and the steer [rad] (the compiled law's reference)."""
         X = np.asarray(X, dtype=float)
         Xw, Yw = self.wheel(X)
-        s, e = path_coordinates(self.path, Xw, Yw, self.U * np.asarray(t, dtype=float))
+        s, e = path_coordinates(self.path, Xw, Yw, heading_rad=-X[2])       # unit 1's heading, left positive
         delta_kin = np.interp(s, self._s_grid, self._delta_kin)        # clamped to the run's ends
         return s, e, -delta_kin + self.K * e + self.K_I * X[-1]
 

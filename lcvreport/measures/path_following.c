@@ -41,26 +41,28 @@ void lcv_path_following(const Law *L, long long B, const double *t, const double
         double c = cos(x[2]), sn = sin(x[2]);
         double X = x[0] + L->x_m * c - L->half_track * sn;
         double Y = -(x[1] + L->x_m * sn + L->half_track * c);
-        double hint = L->U * t[b];
+        double h = -x[2];       /* unit 1's heading, left positive, unwrapped: the place on the path */
+        int approach = h < 0.5 * M_PI, leaving = h > a - 0.5 * M_PI;
         double d[5], s[5], e[5];
-        /* the approach */
-        d[0] = X <= 0.0 ? fabs(Y) : INFINITY;
+        /* the approach, while heading within a quarter turn of its direction */
+        d[0] = (X <= 0.0 && approach) ? fabs(Y) : INFINITY;
         s[0] = X; e[0] = Y;
-        /* the arc, on the lap nearest the hint */
+        /* the arc, on the lap nearest the heading */
         double phi = atan2(X - Cx, -(Y - Cy));
-        double h = hint < 0.0 ? 0.0 : (hint > L->arc_end ? L->arc_end : hint);
-        phi = phi + two_pi * nearbyint((h / R - phi) / two_pi);
+        double hc = h < 0.0 ? 0.0 : (h > a ? a : h);
+        phi = phi + two_pi * nearbyint((hc - phi) / two_pi);
         double r = hypot(X - Cx, Y - Cy);
         d[1] = (phi >= 0.0 && phi <= a) ? fabs(R - r) : INFINITY;
         s[1] = R * phi; e[1] = R - r;
-        /* the exit */
+        /* the exit, while heading within a quarter turn of its direction */
         double along = (X - ex) * tx + (Y - ey) * ty;
         double e2 = tx * (Y - ey) - ty * (X - ex);
-        d[2] = along >= 0.0 ? fabs(e2) : INFINITY;
+        d[2] = (along >= 0.0 && leaving) ? fabs(e2) : INFINITY;
         s[2] = L->arc_end + along; e[2] = e2;
         /* the corners */
-        d[3] = hypot(X, Y); s[3] = 0.0; e[3] = d[3];
-        d[4] = hypot(X - ex, Y - ey); s[4] = L->arc_end; e[4] = d[4];
+        double dc0 = hypot(X, Y), dc1 = hypot(X - ex, Y - ey);
+        d[3] = approach ? dc0 : INFINITY; s[3] = 0.0; e[3] = dc0;
+        d[4] = leaving ? dc1 : INFINITY; s[4] = L->arc_end; e[4] = dc1;
         int k = 0;
         for (int q = 1; q < 5; q++)
             if (d[q] < d[k] || (isnan(d[q]) && !isnan(d[k]))) k = q;
