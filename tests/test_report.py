@@ -225,27 +225,35 @@ def test_each_kernel_has_its_own_unix_sockets():
 def test_a_temporary_folder_too_long_for_a_socket_keeps_tcp(monkeypatch, tmp_path):
     import tempfile
     monkeypatch.setattr(tempfile, "gettempdir", lambda: str(tmp_path / ("x" * 100)))
-    assert kernel_options() == {"extra_arguments": ["--IPKernelApp.log_level=CRITICAL"]}
+    assert kernel_options(tmp_path) == {"extra_arguments": ["--IPKernelApp.log_level=CRITICAL"],
+                                        "resources": {"metadata": {"path": str(tmp_path)}}}
 
 
 def test_kernels_started_together_all_run(tmp_path):
-    """Four notebooks executed at once on four threads (what the report's build does) all run."""
+    """Four notebooks executed at once on four threads (what the report's build does) all run,
+    each kernel in its folder, and the process's own folder stays where it was (papermill's
+    ``cwd=`` changes it for the whole process: threads restored each other's, and the suite's
+    later tests ran in a test's temporary folder)."""
+    import os
     from concurrent.futures import ThreadPoolExecutor
     import papermill as pm
-    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("x = 6 * 7\nprint(x)")])
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("import os\nprint(os.path.basename(os.getcwd()))")])
     nbformat.write(nb, tmp_path / "tiny.ipynb")
-
-    options = [kernel_options() for _ in range(4)]
+    for i in range(4):
+        (tmp_path / f"run{i}").mkdir()
+    options = [kernel_options(tmp_path / f"run{i}") for i in range(4)]
     sockets = [Path(o["kernel_manager_class"](kernel_name="python3").ip) for o in options]
 
     def run(i):
         out = tmp_path / f"out{i}.ipynb"
-        pm.execute_notebook(str(tmp_path / "tiny.ipynb"), str(out), kernel_name="python3", cwd=str(tmp_path),
-                            progress_bar=False, **options[i])
+        pm.execute_notebook(str(tmp_path / "tiny.ipynb"), str(out), kernel_name="python3", progress_bar=False,
+                            **options[i])
         return nbformat.read(out, as_version=4).cells[0].outputs[0]["text"]
 
+    here = os.getcwd()
     with ThreadPoolExecutor(4) as pool:
-        assert list(pool.map(run, range(4))) == ["42\n"] * 4
+        assert list(pool.map(run, range(4))) == [f"run{i}\n" for i in range(4)]
+    assert os.getcwd() == here
     assert not [p for s in sockets for p in s.parent.glob(s.name + "-*")]     # removed at each kernel's shutdown
 
 

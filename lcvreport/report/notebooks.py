@@ -34,8 +34,11 @@ HTML_ONLY = "lcv-html-only"
 KERNEL_ARGS = ["--IPKernelApp.log_level=CRITICAL"]
 
 
-def kernel_options() -> dict:
-    """The notebook client's options that start each kernel on its own Unix sockets.
+def kernel_options(cwd: Path | str | None = None) -> dict:
+    """The notebook client's options that start each kernel on its own Unix sockets, in the
+    folder ``cwd`` (given to the kernel alone: papermill's own ``cwd=`` changes the folder of the
+    whole process while the notebook runs, and notebooks run in parallel threads then restore
+    each other's, leaving the process in a report's folder).
 
     On TCP, jupyter_client picks a free port, releases it and the kernel binds it later: a
     kernel started meanwhile (the report's notebooks run in parallel, other processes run
@@ -46,10 +49,13 @@ def kernel_options() -> dict:
     import os
     import tempfile
     import uuid
+    options = {"extra_arguments": KERNEL_ARGS}
+    if cwd is not None:
+        options["resources"] = {"metadata": {"path": str(cwd)}}
     base = os.path.join(tempfile.gettempdir(), f"lcv-kernel-{uuid.uuid4().hex[:16]}")
-    if os.name != "posix" or len(base) > 96:          # sun_path holds 108 bytes; "-5" and NUL follow
-        return {"extra_arguments": KERNEL_ARGS}
-    return {"extra_arguments": KERNEL_ARGS, "kernel_manager_class": _ipc_kernel_manager(base)}
+    if os.name == "posix" and len(base) <= 96:        # sun_path holds 108 bytes; "-5" and NUL follow
+        options["kernel_manager_class"] = _ipc_kernel_manager(base)
+    return options
 
 
 def _ipc_kernel_manager(base: str):
@@ -349,7 +355,7 @@ def execute(stem: str, out_dir: Path, parameters: dict, source_dir: Path | None 
     dst = out_dir / f"{stem}.ipynb"
     try:
         pm.execute_notebook(str(src), str(dst), parameters=parameters, kernel_name="python3",
-                            cwd=str(out_dir), progress_bar=False, log_output=False, **kernel_options())
+                            progress_bar=False, log_output=False, **kernel_options(out_dir))
     except pm.PapermillExecutionError as exc:
         if exc.ename == "KeyboardInterrupt":     # Ctrl-C reached the kernel too: an interruption, not a failure
             raise KeyboardInterrupt from None
@@ -512,7 +518,7 @@ def execute_unchecked(stem, nb_dir, params, src):
     dst = nb_dir / f"{stem}.ipynb"
     try:
         pm.execute_notebook(str(src / f"{stem}.ipynb"), str(dst), parameters=params, kernel_name="python3",
-                            cwd=str(nb_dir), progress_bar=False, log_output=False, **kernel_options())
+                            progress_bar=False, log_output=False, **kernel_options(nb_dir))
     except pm.PapermillExecutionError as exc:
         where = _failed_cell(src / f"{stem}.ipynb", dst, exc.cell_index)
         raise ReportError(f"notebook {stem}.ipynb failed in {where}: {exc.ename}: {exc.evalue} "
