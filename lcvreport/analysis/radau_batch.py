@@ -160,15 +160,20 @@ def radau_batch(fun, t0: float, y0: np.ndarray, t_end: float, rtol: float, atol:
     def evaluate(t, Y, rows):
         """fun over the rows of living variants; a failing row's variant dies and its rows are NaN."""
         rows = np.asarray(rows)
+        keep = alive[rows]
+        called = np.unique(rows[keep])
+        count[called] += 1                                 # one call of each variant's equations
+        for b in called[count[called] > max_evaluations]:
+            fail(int(b), f"the integration stopped at t = {float(t[rows == b][0]):.3f} s after {max_evaluations} "
+                         "evaluations of the model's equations (the run cannot be integrated further: a vehicle "
+                         "out of control?)")
+        keep = alive[rows]
+        if keep.all():                                     # the usual call: every row's variant alive
+            try:
+                return np.asarray(fun(t, Y, rows), dtype=float)
+            except RowFailure:
+                pass                                       # the rows again, one failure at a time, below
         out = np.full(Y.shape, np.nan)
-        keep = alive[rows].copy()
-        np.add.at(count, np.unique(rows[keep]), 1)
-        for b in np.unique(rows[keep]):
-            if count[b] > max_evaluations:
-                fail(int(b), f"the integration stopped at t = {float(t[rows == b][0]):.3f} s after {max_evaluations} "
-                             "evaluations of the model's equations (the run cannot be integrated further: a vehicle "
-                             "out of control?)")
-        keep = alive[rows].copy()
         while keep.any():
             sel = np.flatnonzero(keep)
             try:
@@ -243,39 +248,59 @@ def radau_batch(fun, t0: float, y0: np.ndarray, t_end: float, rtol: float, atol:
         converged = np.zeros(k, dtype=bool)
         going = np.ones(k, dtype=bool)
         n_iter = np.zeros(k, dtype=np.int64)
+        t_i, y_i, inv_r, inv_c = t[idx][:, None], y[idx][:, None, :], inv_real[idx], inv_complex[idx]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            return _newton_iterations(idx, k, W, Z, ch, dW_norm_old, rate, converged, going, n_iter, t_i, y_i,
+                                      inv_r, inv_c, M_real, M_complex, scale)
+
+    def _newton_iterations(idx, k, W, Z, ch, dW_norm_old, rate, converged, going, n_iter, t_i, y_i, inv_r, inv_c,
+                           M_real, M_complex, scale):
         for it in range(NEWTON_MAXITER):
             g = np.flatnonzero(going & alive[idx])
             if g.size == 0:
                 break
             n_iter[g] = it + 1
-            F = evaluate((t[idx[g]][:, None] + ch[g]).ravel(), (y[idx[g]][:, None, :] + Z[g]).reshape(-1, n),
-                         np.repeat(idx[g], 3)).reshape(g.size, 3, n)
-            finite = np.isfinite(F).all(axis=(1, 2))
-            going[g[~finite]] = False
-            g, F = g[finite], F[finite]
-            if g.size == 0:
-                continue
-            f_real = np.einsum("kin,i->kn", F, TI_REAL) - M_real[g, None] * W[g, 0]
-            f_complex = np.einsum("kin,i->kn", F, TI_COMPLEX) - M_complex[g, None] * (W[g, 1] + 1j * W[g, 2])
-            dW_real = np.einsum("kij,kj->ki", inv_real[idx[g]], f_real)
-            dW_complex = np.einsum("kij,kj->ki", inv_complex[idx[g]], f_complex)
+            G = slice(None) if g.size == k else g          # all of them (the usual case): views, not copies
+            F = evaluate((t_i[G] + ch[G]).ravel(), (y_i[G] + Z[G]).reshape(-1, n),
+                         np.repeat(idx[G], 3)).reshape(g.size, 3, n)
+            if not np.isfinite(F).all():
+                finite = np.isfinite(F).all(axis=(1, 2))
+                going[g[~finite]] = False
+                g, F = g[finite], F[finite]
+                if g.size == 0:
+                    continue
+                G = g
+            f_real = np.einsum("kin,i->kn", F, TI_REAL) - M_real[G, None] * W[G, 0]
+            f_complex = np.einsum("kin,i->kn", F, TI_COMPLEX) - M_complex[G, None] * (W[G, 1] + 1j * W[G, 2])
+            dW_real = np.einsum("kij,kj->ki", inv_r[G], f_real)
+            dW_complex = np.einsum("kij,kj->ki", inv_c[G], f_complex)
             dW = np.stack([dW_real, dW_complex.real, dW_complex.imag], axis=1)
-            dW_norm = _rms(dW / scale[g, None, :])
-            has_old = ~np.isnan(dW_norm_old[g])
-            rate[g] = np.where(has_old, dW_norm / np.where(has_old, dW_norm_old[g], 1.0), rate[g])
-            r = rate[g]
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            dW_norm = _rms(dW / scale[G, None, :])
+            if it == 0:                                    # no rate yet (NaN): none diverges
+                gg, GG = g, G
+                done = dW_norm == 0
+            else:
+                norm_old = dW_norm_old[G]
+                has_old = ~np.isnan(norm_old)
+                if has_old.all():
+                    rate[G] = dW_norm / norm_old
+                else:
+                    rate[G] = np.where(has_old, dW_norm / np.where(has_old, norm_old, 1.0), rate[G])
+                r = rate[G]
                 diverge = ~np.isnan(r) & ((r >= 1) | (r ** (NEWTON_MAXITER - it) / (1 - r) * dW_norm > newton_tol))
-            going[g[diverge]] = False
-            ok = ~diverge
-            gg = g[ok]
-            W[gg] += dW[ok]
-            Z[gg] = np.einsum("ij,kjn->kin", T, W[gg])
-            with np.errstate(divide="ignore", invalid="ignore"):
-                done = (dW_norm[ok] == 0) | (~np.isnan(r[ok]) & (r[ok] / (1 - r[ok]) * dW_norm[ok] < newton_tol))
+                if diverge.any():
+                    going[g[diverge]] = False
+                    ok = ~diverge
+                    gg = g[ok]
+                    GG, dW, dW_norm, r = gg, dW[ok], dW_norm[ok], r[ok]
+                else:
+                    gg, GG = g, G
+                done = (dW_norm == 0) | (~np.isnan(r) & (r / (1 - r) * dW_norm < newton_tol))
+            W[GG] += dW
+            Z[GG] = np.einsum("ij,kjn->kin", T, W[GG])
             converged[gg[done]] = True
             going[gg[done]] = False
-            dW_norm_old[gg] = dW_norm[ok]
+            dW_norm_old[GG] = dW_norm
         return converged & alive[idx], n_iter, Z, rate
 
     while True:

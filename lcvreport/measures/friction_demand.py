@@ -190,20 +190,23 @@ class PathFollowing:
         (the last call's remembered: the law and the equations ask for the same states)."""
         return self._law(t, X)[:2]
 
-    def _law(self, t, X) -> tuple:
+    def _law(self, t, X, remember: bool = True) -> tuple:
         """(s, e, delta) of :meth:`error` and the steer, by the compiled law where this machine
         has it (path_following.c), the same arithmetic in numpy otherwise; the last call's
-        remembered."""
+        remembered (``remember=False``: neither looked up nor kept -- a caller that takes all
+        three at once)."""
         X = np.asarray(X, dtype=float)
         t = np.asarray(t, dtype=float)
-        key = (t.tobytes(), X.tobytes())
-        if self._memo[0] == key:
-            return self._memo[1]
+        if remember:
+            key = (t.tobytes(), X.tobytes())
+            if self._memo[0] == key:
+                return self._memo[1]
         if self._compiled is not None and X.ndim == 2:
-            out = self._compiled(np.broadcast_to(t, X.shape[1:]), X)
+            out = self._compiled(t if t.shape == X.shape[1:] else np.broadcast_to(t, X.shape[1:]), X)
         else:
             out = self.law_numpy(t, X)
-        self._memo = (key, out)
+        if remember:
+            self._memo = (key, out)
         return out
 
     def law_numpy(self, t, X) -> tuple:
@@ -501,9 +504,10 @@ def _compiled_law(follow: PathFollowing):
         rows = np.ascontiguousarray(X.T)
         k, n = rows.shape
         t = np.ascontiguousarray(t, dtype=float)
-        s, e, delta = np.empty(k), np.empty(k), np.empty(k)
-        f(ctypes.byref(law), k, t.ctypes.data, rows.ctypes.data, n, s.ctypes.data, e.ctypes.data, delta.ctypes.data)
-        return s, e, delta
+        out = np.empty((3, k))                               # s, e, delta
+        at = out.ctypes.data
+        f(ctypes.byref(law), k, t.ctypes.data, rows.ctypes.data, n, at, at + 8 * k, at + 16 * k)
+        return out[0], out[1], out[2]
     return call
 
 
@@ -560,14 +564,20 @@ def turns_with_tire_forces(vehicles, radius_m: float = RADIUS_M, angle_deg: floa
         w0 = input_vector(model, 0.0, None, tire_scale)
         params = Parameters.concatenate([m._p for _k, _v, _kin, m in members])
 
-        def fun(t, Y, rows, follow=follow, model=model, params=params, w0=w0):
-            W = np.tile(w0, (Y.shape[0], 1))
-            W[:, 0] = follow(t, Y.T)
+        def fun(t, Y, rows, follow=follow, model=model, params=params, w0=w0, taken={}):
+            W = np.broadcast_to(w0, (Y.shape[0], w0.size)).copy()
+            _s, e, W[:, 0] = follow._law(t, Y.T, remember=False)
+            key = rows.tobytes()                       # the calls' few patterns of rows: each taken once
+            p = taken.get(key)
+            if p is None:
+                if len(taken) >= 256:
+                    taken.clear()
+                p = taken[key] = params.take(rows)
             try:
-                dx = model.derivatives(t, Y[:, :-1], W, U, tire_scale, params=params.take(rows))
+                dx = model.derivatives_rows(Y[:, :-1], W, U, tire_scale, p)
             except TractionError as exc:
                 raise RowFailure(exc.row, str(exc)) from None
-            return np.column_stack([dx, U * follow.error(t, Y.T)[1]])
+            return np.column_stack([dx, U * e])
 
         runs = radau_batch(fun, 0.0, np.tile(x0, (len(members), 1)), t_end, rtol, ATOL,
                            stop=lambda t, Y, rows, follow=follow: LOST_PATH_M - np.abs(follow.error(t, Y.T)[1]))

@@ -377,7 +377,7 @@ class NonlinearModel:
         x, w = np.asarray(x), np.asarray(w)
         one = x.ndim == 1
         x2 = np.atleast_2d(x)
-        w2 = np.broadcast_to(np.atleast_2d(w), (x2.shape[0], w.shape[-1]))
+        w2 = w if w.ndim == 2 and w.shape[0] == x2.shape[0] else np.broadcast_to(np.atleast_2d(w), (x2.shape[0], w.shape[-1]))
         return x2, w2, one
 
     def derivatives(self, t: float, x: np.ndarray, w: np.ndarray, speed_mps: float,
@@ -394,16 +394,30 @@ class NonlinearModel:
             A driven axle out of friction: the speed cannot be held.
         """
         x2, w2, one = self._batch(x, w)
-        if x2.dtype == np.float64 and w2.dtype.kind in "fiu":
-            eq = _compiled(self)
-            if eq is not None:                          # the same equations compiled (native.py)
-                p = params if params is not None else self._p.take(np.zeros(x2.shape[0], dtype=int))
-                dx, _D, failed = eq.derivatives(x2, w2, float(speed_mps), tire_scale, p)
-                if dx is None:
-                    row, j, needed, available = failed
-                    raise TractionError(self.vehicle.axles[j].name, needed, available, row)
-                return dx[0] if one else dx
+        if x2.dtype == np.float64 and w2.dtype.kind in "fiu" and _compiled(self) is not None:
+            p = params if params is not None else self._p.take(np.zeros(x2.shape[0], dtype=int))
+            dx = self.derivatives_rows(x2, w2, speed_mps, tire_scale, p)
+            return dx[0] if one else dx
         return self.derivatives_numpy(t, x, w, speed_mps, tire_scale, params)
+
+    def derivatives_rows(self, x: np.ndarray, w: np.ndarray, speed_mps: float, tire_scale: float,
+                         params: Parameters) -> np.ndarray:
+        """:meth:`derivatives` of real states ``x`` (B, n) with inputs ``w`` (B, n_w) and each
+        row's ``params``, without the conversions: a batch integrator's call (compiled where the
+        machine has the library, numpy otherwise).
+
+        Raises
+        ------
+        TractionError
+        """
+        eq = _compiled(self)
+        if eq is None:
+            return self.derivatives_numpy(0.0, x, w, speed_mps, tire_scale, params)
+        dx, _D, failed = eq.derivatives(x, w, float(speed_mps), tire_scale, params)
+        if dx is None:
+            row, j, needed, available = failed
+            raise TractionError(self.vehicle.axles[j].name, needed, available, row)
+        return dx
 
     def derivatives_numpy(self, t: float, x: np.ndarray, w: np.ndarray, speed_mps: float,
                           tire_scale: float = 1.0, params: Parameters | None = None) -> np.ndarray:

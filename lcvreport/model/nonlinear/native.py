@@ -77,6 +77,21 @@ class CompiledEquations:
                                                                        ("c", "au", "x", "tires", "steered", "driven",
                                                                         "drive_share")))
         self.n_states, self.n_axles = 2 * model._N + 3, model._x.size
+        self._param_structs: dict = {}
+
+    def _params(self, p) -> "_Params":
+        """The C structure of the parameters ``p``, made once per :class:`Parameters` object (an
+        integration calls the equations with the same few hundreds of times; the object is kept
+        with it, so that its id is not reused)."""
+        hit = self._param_structs.get(id(p))
+        if hit is not None and hit[0] is p:
+            return hit[2]
+        arrays = [np.ascontiguousarray(a, dtype=float) for a in (p.m, p.I, p.CF, p.CM, p.tires_CSD2, p.Fz_tire, p.mu_Fz)]
+        if len(self._param_structs) >= 64:
+            self._param_structs.clear()
+        struct = _Params(*(a.ctypes.data for a in arrays))
+        self._param_structs[id(p)] = (p, arrays, struct)
+        return struct
 
     def derivatives(self, x: np.ndarray, w: np.ndarray, speed_mps: float, tire_scale: float, p,
                     forces: bool = False):
@@ -86,15 +101,16 @@ class CompiledEquations:
         x = np.ascontiguousarray(x, dtype=float)
         w = np.ascontiguousarray(w, dtype=float)
         B = x.shape[0]
-        arrays = [np.ascontiguousarray(a, dtype=float) for a in (p.m, p.I, p.CF, p.CM, p.tires_CSD2, p.Fz_tire, p.mu_Fz)]
-        params = _Params(*(a.ctypes.data for a in arrays))
-        dx = np.empty((B, self.n_states))
-        D = np.empty(B)
+        params = self._params(p)
+        n = self.n_states
+        buf = np.empty(B * (n + 1))                      # x' (B, n), then D (B,): one allocation
+        dx, D = buf[:B * n].reshape(B, n), buf[B * n:]
+        at = buf.ctypes.data
         F = np.empty((B, 2, self.n_axles)) if forces else None
         fail = _Failure()
         code = self._lib.lcv_nonlinear_derivatives(ctypes.byref(self._model), ctypes.byref(params), B, x.ctypes.data,
-                                                   w.ctypes.data, float(speed_mps), float(tire_scale), dx.ctypes.data,
-                                                   D.ctypes.data, None if F is None else F.ctypes.data,
+                                                   w.ctypes.data, float(speed_mps), float(tire_scale), at,
+                                                   at + 8 * B * n, None if F is None else F.ctypes.data,
                                                    ctypes.byref(fail))
         if code:
             return None, None, (int(fail.row), int(fail.axle), float(fail.needed), float(fail.available))
