@@ -40,7 +40,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.integrate import integrate
 from ..model.body import overall_length_m
 from ..model.nonlinear.model import FRICTION_COEFFICIENT, driven_axles, nonlinear_model
 from ..model.vehicle import Vehicle
