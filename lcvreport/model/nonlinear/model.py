@@ -403,15 +403,26 @@ class NonlinearModel:
     def derivatives_rows(self, x: np.ndarray, w: np.ndarray, speed_mps: float, tire_scale: float,
                          params: Parameters) -> np.ndarray:
         """:meth:`derivatives` of real states ``x`` (B, n) with inputs ``w`` (B, n_w) and each
-        row's ``params``, without the conversions: a batch integrator's call (compiled where the
-        machine has the library, numpy otherwise).
+        row's ``params`` (one row per state), without the conversions: a batch integrator's call
+        (compiled where the machine has the library, numpy otherwise).  ``speed_mps`` [m/s].
 
         Raises
         ------
         TractionError
+
+        Examples
+        --------
+        >>> from lcvreport.model.presets import load_preset
+        >>> m = nonlinear_model(load_preset("tractor_semitrailer"))
+        >>> x = np.zeros((2, m.n_states))
+        >>> w = np.tile(m.zero_input(), (2, 1))
+        >>> w[1, 0] = 0.01                                  # the second state steered 0.01 rad
+        >>> dx = m.derivatives_rows(x, w, 20.0, 1.0, m._p.take(np.zeros(2, dtype=int)))
+        >>> bool(np.all(dx == m.derivatives(0.0, x, w, 20.0))), bool(dx[1, m.n_states - 2] != 0.0)
+        (True, True)
         """
         eq = _compiled(self)
-        if eq is None:
+        if eq is None or x.dtype != np.float64:
             return self.derivatives_numpy(0.0, x, w, speed_mps, tire_scale, params)
         dx, _D, failed = eq.derivatives(x, w, float(speed_mps), tire_scale, params)
         if dx is None:
