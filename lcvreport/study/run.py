@@ -410,15 +410,29 @@ class _workers_quiet:
         return False
 
 
-def _run_distributed(study, todo, bounds, chunks, workers, scheduler, bar) -> None:
+#: the loggers of Dask's machinery (and every logger below them)
+DASK_LOGGERS = ("distributed", "tornado", "asyncio")
+
+
+def quiet_dask_logging() -> None:
+    """Nothing from Dask's machinery reaches the terminal: failures reach the study through its
+    futures, and an interrupt (Ctrl-C, a batch system's SIGTERM) that lands while the event loop
+    runs a callback makes tornado log "Exception in callback" with a traceback -- the command's
+    one line says it was interrupted.  Every logger below those names too: distributed's own
+    configuration gives ``tornado.application`` a level of its own (ERROR), which a level set on
+    ``tornado`` does not reach (that traceback got through, now and then)."""
+    import importlib
     import logging
 
-    from dask.distributed import Client, LocalCluster, as_completed
-    # failures reach us through the futures; an interrupt (Ctrl-C, a batch system's SIGTERM) that
-    # lands while the event loop runs a callback makes tornado log "Exception in callback" with a
-    # traceback on a loaded machine: the command's one line says it was interrupted
-    for name in ("distributed", "tornado", "asyncio"):
+    importlib.import_module("distributed")          # its logging configuration first, then ours over it
+    names = set(DASK_LOGGERS) | {n for n in logging.root.manager.loggerDict if n.split(".")[0] in DASK_LOGGERS}
+    for name in names:
         logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
+def _run_distributed(study, todo, bounds, chunks, workers, scheduler, bar) -> None:
+    from dask.distributed import Client, LocalCluster, as_completed
+    quiet_dask_logging()
     doc = study.to_dict()
     cluster = None
     try:
