@@ -18,6 +18,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``files``            the one guarded reader of every file a user hands in (regular files, a size limit, UTF-8)
     ``text``             what a user's text may hold (no control characters) and how a message quotes it
     ``compiled``         the package's C sources compiled on this machine, cached, loaded (ctypes)
+    ``interrupts``       Ctrl-C and SIGTERM the interpreter swallowed still end a command as interrupted
 ``model/``               **what a vehicle is, and the models of it** (numpy only):
     ``vehicle``          Axle, Unit, Vehicle (SI parameter sets, validated)
     ``vehicle_file``     vehicle files (TOML, SI): load_vehicle, dumps_vehicle

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 
 def main() -> None:
+    from .util.interrupts import install
+    install()                       # first: an interrupt during the imports is not lost
     from .util.threads import configure_entry_point
     configure_entry_point()
     from .cli.main import main as cli_main

@@ -8,6 +8,7 @@ from pathlib import Path
 
 
 from ..ranges import RangeError
+from ..util.interrupts import raise_if_interrupted
 from .options import (Command, UsageError, add_load, add_residuals, add_source, add_speed, load_units_of,
                       model_choices, sources_of, speed_mps_of, vehicle_of)
 from .output import OutputError, Output
@@ -178,6 +179,7 @@ def cmd_study(args, out: Output) -> int:
         tmp = out_dir / ".results.csv.tmp"
         read_study(out_dir).to_csv(tmp, index=False, float_format="%.17g")
         try:
+            raise_if_interrupted()     # an interruption the interpreter swallowed: nothing is linked
             os.link(tmp, csv_path)
         except FileExistsError:
             raise UsageError(f"argument --csv: {csv_path} appeared meanwhile; nothing was overwritten") from None

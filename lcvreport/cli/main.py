@@ -81,6 +81,8 @@ def run(argv: Sequence[str] | None = None, out=None) -> int:
     """Run ``lcv`` with ``argv``; return the exit status.  Output goes to ``out`` (stdout)."""
     import signal
     import threading
+
+    from ..util import interrupts
     stream = out if out is not None else sys.stdout
     previous = None
     try:
@@ -92,8 +94,12 @@ def run(argv: Sequence[str] | None = None, out=None) -> int:
             previous = signal.signal(signal.SIGTERM, _terminated)
         status = COMMANDS[args.command](args, writer)
         stream.flush()
+        # an interruption the interpreter swallowed (it landed in a weakref callback): the command
+        # checked it before publishing anything; it ends as any other interruption
+        interrupts.raise_if_interrupted()
         return status
     except KeyboardInterrupt:
+        interrupts.clear()
         print("lcv: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except UsageError as exc:
@@ -126,8 +132,9 @@ def run(argv: Sequence[str] | None = None, out=None) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
-def _terminated(_signum, _frame):
-    raise KeyboardInterrupt
+def _terminated(signum, frame):
+    from ..util.interrupts import on_signal
+    on_signal(signum, frame)
 
 
 def _silence_stdout() -> None:

@@ -52,6 +52,8 @@ def write_figure_new(fig, path: Path) -> None:
     """Save a figure to a new file: written aside, then linked into place (never over a file)."""
     import os
     import tempfile
+
+    from ..util.interrupts import raise_if_interrupted
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
     umask = os.umask(0)
     os.umask(umask)
@@ -59,6 +61,7 @@ def write_figure_new(fig, path: Path) -> None:
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=150)
+        raise_if_interrupted()     # an interruption the interpreter swallowed: nothing is linked
         try:
             os.link(tmp, path)
         except FileExistsError:

@@ -348,6 +348,9 @@ def silence_client_loggers() -> None:
 def execute(stem: str, out_dir: Path, parameters: dict, source_dir: Path | None = None) -> Path:
     """Check the parameters, then execute ``<source_dir>/<stem>.ipynb`` with papermill into ``out_dir``."""
     import papermill as pm
+
+    from ..util.interrupts import raise_if_interrupted
+    raise_if_interrupted()          # one the interpreter swallowed (in the imports): no kernel is started
     silence_client_loggers()
     if stem in SPECS:
         check_notebook_parameters(stem, parameters)
@@ -515,6 +518,9 @@ def overfull_boxes(log_text: str) -> list[tuple[float, str]]:
 
 def execute_unchecked(stem, nb_dir, params, src):
     import papermill as pm
+
+    from ..util.interrupts import raise_if_interrupted
+    raise_if_interrupted()          # one the interpreter swallowed (in the imports): no kernel is started
     dst = nb_dir / f"{stem}.ipynb"
     try:
         pm.execute_notebook(str(src / f"{stem}.ipynb"), str(dst), parameters=params, kernel_name="python3",

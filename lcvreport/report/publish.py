@@ -211,6 +211,9 @@ def publish_staged(staged: Path, out: Path, existed_as: tuple) -> None:
     while it runs (the renames and the removal of the old report are one step: an interruption
     never leaves a half-removed copy beside the new report) and take effect after it."""
     import os
+
+    from ..util.interrupts import raise_if_interrupted
+    raise_if_interrupted()         # an interruption the interpreter swallowed: nothing is published
     with _deferred_interrupts():
         now = folder_state(out)
         if now != existed_as:
