@@ -14,39 +14,43 @@ def hermite_roots(f0, d0, f1, d1, h) -> np.ndarray:
     """The roots in [0, 1] of cubic Hermite interpolants of f (values f0, f1 of opposite
     sign, slopes d0, d1 per unit time over a step h, one for all or one each), vectorized:
     Newton from the secant root, kept inside a bracket that shrinks with every iterate
-    (safeguarded)."""
+    (safeguarded).  Each root stops when its own iterate settles, as :func:`_hermite_root` does
+    on one: the same arithmetic, so every root equals that function's bit for bit, whatever
+    the other roots of the call (a batch's values do not depend on the variants beside them),
+    and the iteration works on the unsettled roots only."""
     f0, d0, f1, d1 = (np.asarray(a, dtype=float) for a in (f0, d0, f1, d1))
     if f0.ndim == 1 and f0.size <= 16:     # the usual few roots: the same iteration on floats, no array overhead
         hs = np.broadcast_to(np.asarray(h, dtype=float), f0.shape).tolist()
         return np.array([_hermite_root(*args) for args in zip(f0.tolist(), d0.tolist(), f1.tolist(),
                                                               d1.tolist(), hs)])
+    shape = np.broadcast_shapes(f0.shape, d0.shape, f1.shape, d1.shape, np.shape(h))
+    f0, d0, f1, d1, h = (np.broadcast_to(a, shape).ravel() for a in (f0, d0, f1, d1, np.asarray(h, dtype=float)))
     d0, d1 = d0 * h, d1 * h
     a = 2 * f0 - 2 * f1 + d0 + d1
     b = -3 * f0 + 3 * f1 - 2 * d0 - d1
-    lo, hi = np.zeros(f0.shape), np.ones(f0.shape)
     denom = f0 - f1
     tau = np.where(denom != 0, f0 / np.where(denom != 0, denom, 1.0), 0.0).clip(0.0, 1.0)
-    s0 = np.sign(f0)
     tau = np.where(f0 == 0, 0.0, np.where(f1 == 0, 1.0, tau))
-    active = (f0 != 0) & (f1 != 0)
-    if not active.any():
-        return tau
+    k = np.flatnonzero((f0 != 0) & (f1 != 0))          # the roots still iterating
+    a, b, d0, f0, t = a[k], b[k], d0[k], f0[k], tau[k]
+    s0 = np.sign(f0)
+    lo, hi = np.zeros(k.size), np.ones(k.size)
     for _ in range(40):
-        p = ((a * tau + b) * tau + d0) * tau + f0
-        dp = (3 * a * tau + 2 * b) * tau + d0
+        if not k.size:
+            break
+        p = ((a * t + b) * t + d0) * t + f0
+        dp = (3 * a * t + 2 * b) * t + d0
         same = np.sign(p) == s0
-        lo = np.where(same, tau, lo)
-        hi = np.where(same, hi, tau)
+        lo = np.where(same, t, lo)
+        hi = np.where(same, hi, t)
         step = np.where(dp != 0, p / np.where(dp != 0, dp, 1.0), 0.0)
-        new = tau - step
+        new = t - step
         bad = (new < lo) | (new > hi) | ~np.isfinite(new)
         new = np.where(bad, 0.5 * (lo + hi), new)
-        new = np.where(active, new, tau)
-        if np.all(np.abs(new - tau) <= 1e-13):
-            tau = new
-            break
-        tau = new
-    return tau
+        tau[k] = new
+        go = ~(np.abs(new - t) <= 1e-13)                 # settled: this root's value is final
+        k, a, b, d0, f0, s0, lo, hi, t = (x[go] for x in (k, a, b, d0, f0, s0, lo, hi, new))
+    return tau.reshape(shape)
 
 
 def _hermite_root(f0: float, d0: float, f1: float, d1: float, h: float) -> float:
