@@ -301,3 +301,31 @@ def test_a_b_double_past_three_quarter_turns_is_refused_by_its_traction():
     with pytest.raises(IntegrationError, match=r"at t = 3\d\.\d+ s: driven axle drive1 needs .* the speed cannot be held"):
         turn_with_tire_forces(v, angle_deg=360.0)
     assert turn_with_tire_forces(v, angle_deg=250.0).stfd is not None
+
+
+def test_a_vehicle_that_differs_only_in_its_bodies_shares_the_run_and_reads_its_own_bodies():
+    """The run of the turn with tire forces reads the bodies only through the overall length (the
+    exit straight): a variant with wider bodies finds the run computed for the vehicle, and its
+    answer equals the one computed for it alone, bit for bit -- friction demands, path error, the
+    poses -- with the swept path of its own bodies.  A longer rear overhang (a longer vehicle) is
+    a new run."""
+    v = load_vehicle(EXAMPLES / "b_double.toml")
+    wider = dataclasses.replace(v, units=tuple(dataclasses.replace(u, body_width_m=u.body_width_m + 0.2)
+                                               for u in v.units))
+    last = v.units[-1]
+    longer = dataclasses.replace(v, units=(*v.units[:-1], dataclasses.replace(last, body_rear_m=last.body_rear_m - 0.5)))
+    turn_with_tire_forces.cache_clear()
+    base = turn_with_tire_forces(v)
+    shared = turn_with_tire_forces(wider)
+    assert shared.response is base.response and shared.vehicle is wider          # the run found, not recomputed
+    assert turn_with_tire_forces(longer).response is not base.response
+    turn_with_tire_forces.cache_clear()
+    alone = turn_with_tire_forces(wider)
+    assert alone.response is not base.response
+    assert (shared.stfd, shared.friction_demand_drive, shared.path_error_max_m, shared.friction_demand) == \
+        (alone.stfd, alone.friction_demand_drive, alone.path_error_max_m, alone.friction_demand)
+    r, q = shared.response, alone.response
+    assert np.array_equal(r.time, q.time) and np.array_equal(r.state_at(r.time), q.state_at(q.time))
+    assert shared.turn.to_dict() == alone.turn.to_dict()
+    assert shared.turn.lssp_m > base.turn.lssp_m + 0.1                           # its own, wider bodies
+    assert shared.kinematic.to_dict() == alone.kinematic.to_dict()

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import copy
 import ctypes
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -396,15 +397,23 @@ def turn_with_tire_forces(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_de
     >>> round(t.stfd, 3), t.path_error_max_m < 0.05
     (0.212, True)
     """
-    key = _key(vehicle, radius_m, angle_deg, speed_kph, friction_coefficient, path_gain_rad_per_m, tire,
-               tire_scale, rtol)
+    args = (radius_m, angle_deg, speed_kph, friction_coefficient, path_gain_rad_per_m, tire, tire_scale, rtol)
+
+    def compute():
+        return vehicle, turns_with_tire_forces([vehicle], *args)[0]
+    key = _key(vehicle, *args)
     if key is None:                                 # an argument that does not hash: its own refusal below
-        out = turns_with_tire_forces([vehicle], radius_m, angle_deg, speed_kph, friction_coefficient,
-                                     path_gain_rad_per_m, tire, tire_scale, rtol)[0]
+        owner, out = compute()
     else:
-        out = _RESULTS.get(key, lambda: turns_with_tire_forces(
-            [vehicle], radius_m, angle_deg, speed_kph, friction_coefficient, path_gain_rad_per_m, tire, tire_scale,
-            rtol)[0])
+        owner, out = _RESULTS.get(key, compute)
+        if owner is not vehicle and owner != vehicle:
+            # a vehicle that differs only in its bodies' widths and overhangs (the same overall
+            # length): the same run, bit for bit; its turn's measures on its own bodies
+            if isinstance(out, Exception):          # a refusal may name a body: its own
+                owner, out = compute()
+            else:
+                out = dataclasses.replace(out, vehicle=vehicle, kinematic=low_speed_turn(vehicle, radius_m, angle_deg),
+                                          undefined=dict(out.undefined))
     if isinstance(out, Exception):
         raise out
     return out
@@ -415,12 +424,23 @@ def turn_with_tire_forces(vehicle: Vehicle, radius_m: float = RADIUS_M, angle_de
 _RESULTS = LRUCache(256)
 
 
+#: the unit keys the run of the turn with tire forces does not read: the bodies' extents, which
+#: reach it only through the vehicle's overall length (the exit straight's length), which the key
+#: holds; the turn's measures on the run's poses (``turn``) read them, from the vehicle asked about
+BODY_KEYS = ("body_front_m", "body_rear_m", "body_width_m", "rear_end_m")
+
+
 def _key(vehicle, *args) -> tuple | None:
-    """The cache key of a turn's arguments, or None where one does not hash (a bad argument)."""
+    """The cache key of a turn's arguments: the vehicle without its bodies (:data:`BODY_KEYS`),
+    its overall length and the arguments; None where one does not hash (a bad argument) or the
+    vehicle has no overall length (its refusal is the turn's)."""
     try:
-        key = (vehicle, *(float(a) if isinstance(a, (int, float)) and not isinstance(a, bool) else a for a in args))
+        run_vehicle = dataclasses.replace(vehicle, units=tuple(dataclasses.replace(u, **dict.fromkeys(BODY_KEYS))
+                                                              for u in vehicle.units))
+        key = (run_vehicle, overall_length_m(vehicle),
+               *(float(a) if isinstance(a, (int, float)) and not isinstance(a, bool) else a for a in args))
         hash(key)
-    except TypeError:
+    except Exception:                                  # noqa: BLE001 - not a vehicle, no bodies: no key
         return None
     return key
 
@@ -448,8 +468,8 @@ def prefetch_turns(vehicles, radius_m: float = RADIUS_M, angle_deg: float = ANGL
     items = list(todo.items())[:_RESULTS.maxsize]
     if not items:
         return
-    for (key, _v), out in zip(items, turns_with_tire_forces([v for _k, v in items], *args)):
-        _RESULTS.get(key, lambda out=out: out)
+    for (key, v), out in zip(items, turns_with_tire_forces([v for _k, v in items], *args)):
+        _RESULTS.get(key, lambda v=v, out=out: (v, out))
 
 
 def prefetch_cases(vehicles, tire_scales, keys, conditions: dict | None = None) -> None:
