@@ -136,6 +136,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``publish``          output folder checks, staging, manifest, atomic publish
     ``build``            the thesis report, the assessment report, the study report
 ``cli/``                 **the ``lcv`` command**, one module per command group (``__main__``: ``python -m lcvreport.cli``):
+    ``start``            the start: Ctrl-C recorded, one BLAS thread, then ``main``
     ``main``             the parser, dispatch and exit statuses
     ``options``          the options the commands share (vehicle, speed, loads, residual sources)
     ``output``           the output stream and figures written aside
@@ -147,7 +148,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``roll``             the static rollover threshold, roll gains, LTR
     ``assess``           an assessment against a scheme file: the verdict table, text or JSON
     ``artifacts``        fmu, report, study
-``_entry``               the console script (one BLAS thread first)
+``_entry``               the console script (``cli.start``)
 
 Units
 -----

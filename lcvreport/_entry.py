@@ -1,12 +1,8 @@
-"""The ``lcv`` console script: one BLAS thread unless told otherwise (:mod:`lcvreport.util.threads`),
-set before numpy is imported, then :func:`lcvreport.cli.main.main`."""
+"""The ``lcv`` console script: :func:`lcvreport.cli.start.main` (Ctrl-C recorded from the first
+moment, one BLAS thread before numpy is imported, then the command)."""
 from __future__ import annotations
 
 
 def main() -> None:
-    from .util.interrupts import install
-    install()                       # first: an interrupt during the imports is not lost
-    from .util.threads import configure_entry_point
-    configure_entry_point()
-    from .cli.main import main as cli_main
-    cli_main()
+    from .cli.start import main as start
+    start()

@@ -109,3 +109,25 @@ def test_a_finished_report_is_not_published_after_a_swallowed_ctrl_c(tmp_path, m
     monkeypatch.setattr(interrupts, "_received", None)
     publish_staged(staged, out, before)                               # the same call, no interruption: published
     assert (out / "index.html").read_text() == "<p>finished</p>"
+
+
+#: an interruption while the command's modules load: an import that raises KeyboardInterrupt
+INTERRUPTED_IMPORT = textwrap.dedent("""
+    import sys
+
+    class _Interrupting:
+        def find_spec(self, name, path=None, target=None):
+            if name == "lcvreport.cli.main":
+                raise KeyboardInterrupt
+            return None
+
+    sys.meta_path.insert(0, _Interrupting())
+    sys.argv = ["lcv", "eig", "--preset", "tractor_semitrailer"]
+""")
+
+
+def test_ctrl_c_while_the_command_loads_is_one_line_not_a_traceback():
+    for start in ("import runpy\nrunpy.run_module('lcvreport.cli', run_name='__main__')\n",
+                  "from lcvreport._entry import main\nmain()\n"):
+        p = _python(INTERRUPTED_IMPORT + start)
+        assert p.returncode == 130 and p.stderr.strip().splitlines() == ["lcv: interrupted"], (start, p.stderr)
