@@ -173,8 +173,11 @@ def _accepted(stem: str) -> tuple[str, ...]:
 
 
 WITH_PRESET = [s.stem for s in NOTEBOOKS if "preset" in s.parameters]
-#: every (notebook, preset) it accepts, but the default preset (the full build runs that)
-PRESET_RUNS = [(stem, p) for stem in WITH_PRESET for p in _accepted(stem) if p != "aucnat"]
+#: every (notebook, preset) it accepts, but the default preset (the full build runs that); the
+#: default suite runs each notebook on its first other preset, the rest are marked slow (~95 s of
+#: the suite's time; ``-m slow`` runs them)
+PRESET_RUNS = [pytest.param(stem, p, marks=() if k == 0 else pytest.mark.slow)
+               for stem in WITH_PRESET for k, p in enumerate(q for q in _accepted(stem) if q != "aucnat")]
 REFUSED = [(stem, p) for stem in WITH_PRESET for p in PRESETS if p not in _accepted(stem)]
 
 
