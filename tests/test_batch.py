@@ -257,6 +257,30 @@ def test_a_variants_time_responses_do_not_depend_on_the_variants_beside_it(monke
         assert np.array_equal(other, results[0], equal_nan=True)
 
 
+@pytest.mark.parametrize("name, model", [("aucnat", "yaw_plane"), ("tractor_semitrailer", "yaw_plane"),
+                                         ("b_double", "yaw_roll")])
+def test_a_variants_batched_measures_do_not_depend_on_the_variants_beside_it(name, model):
+    """Every batched measure (the trim's included) of a variant, bit for bit the same computed with
+    16 others, with 4, and alone: a study's chunks never change a number.  (On a machine with
+    AVX-512, BLAS rounds a row of a (B, n) @ (n, k) product by B, and a dot product differently from
+    a matrix-vector one: the lane change's ``b @ [1, x_s, 0, ...]`` and RA's ``x @ map.T`` did.)"""
+    from lcvreport.model.yaw_plane.loads import load_vector, one_percent_rule
+    v = load_vehicle(EXAMPLES / f"{name}.toml") if name == "b_double" else load_preset(name)
+    names = [f"{u.name}.mass_kg" for u in v.units] + [f"{a.name}.cornering_stiffness_N_per_rad" for a in v.axles]
+    rng = np.random.default_rng(12)
+    values = {n: _nominal(v, n) * rng.uniform(0.75, 1.25, 17) for n in names}
+    batch = VariantBatch(v, values).on_model(model)
+    F = np.tile(load_vector(v, one_percent_rule(v, [v.units[-1].name])), (17, 1)) if model == "yaw_plane" else None
+    full = batch_measures(batch, 24.0, F=F)
+    assert np.isfinite(full["hsto_m"]).all() and np.isfinite(full["ra_frequency"]).all()
+    for rows in ([3], [0, 1, 2, 3, 4], [16]):
+        rows = np.array(rows)
+        part = batch_measures(batch.subset(rows), 24.0, F=None if F is None else F[rows])
+        for key, column in full.items():
+            if key != "case_id":
+                assert np.array_equal(part[key], np.asarray(column)[rows], equal_nan=True), (key, rows)
+
+
 def test_a_variant_with_an_unstable_inverse_system_has_no_lane_change():
     """legal_max at 60 m/s has a right-half-plane zero (exact.response refuses the lane change,
     measure_set reports null): its variants get NaN, the others their numbers."""

@@ -78,6 +78,19 @@ def _with(vehicle: Vehicle, name: str, value: float) -> Vehicle:
     raise BatchError(f"unknown parameter {name!r}; valid: {', '.join(valid)}")
 
 
+def _steered_axle_rows(A_x: np.ndarray, b_x: np.ndarray, x_s: float, u: float) -> tuple[np.ndarray, np.ndarray]:
+    """The steered axle's lateral acceleration ``a_s = Cs x + Ds delta`` of every variant (``v_s = v1 +
+    x_s r1``, ``a_s = v_s' + u r1``): ``Cs`` (B, n), ``Ds`` (B,) from ``x' = A_x x + b_x delta``.
+
+    Written as the two terms, not as a product with ``[1, x_s, 0, ...]``: BLAS computes ``b_x @ J``
+    by a dot product for one variant and by a matrix-vector product for several, and on a machine
+    with AVX-512 the latter fuses ``b1 + x_s b2`` into one rounding (FMA) -- a variant's steer
+    would then depend on how many variants share its group (tests/test_batch.py)."""
+    Cs = A_x[:, 0, :] + x_s * A_x[:, 1, :]
+    Cs[:, 1] += u
+    return Cs, b_x[:, 0] + x_s * b_x[:, 1]
+
+
 def _nominal(vehicle: Vehicle, name: str) -> float:
     owner, _, key = name.partition(".")
     for u in vehicle.units:
@@ -221,8 +234,11 @@ class VariantBatch:
         S = stiffness(c, u, tire_scale)
         b = tire_scale * c["Bdelta"]
         w = 2 * np.pi * float(f_hz)
-        x = np.linalg.solve(1j * w * M - S, b[..., None])[..., 0]
-        return x @ co.velocity_map(u).T * (1j * w) + u * (x @ co.yaw_rate_map().T)
+        x = np.linalg.solve(1j * w * M - S, b[..., None])            # (B, n, 1)
+        # products per variant (stacks of 1-row matrices): a (B, n) @ (n, N) product may round a
+        # variant by B (AVX-512 kernels), and a study's chunks would change its numbers
+        x = np.swapaxes(x, 1, 2)
+        return (x @ co.velocity_map(u).T * (1j * w) + u * (x @ co.yaw_rate_map().T))[:, 0]
 
     def rearward_amplification(self, speed_mps: float, f_hz: float, tire_scale: float = 1.0) -> np.ndarray:
         """RA(f) = |G_N| / |G_1| [-] of every variant, shape (B,)."""
@@ -340,11 +356,7 @@ class VariantBatch:
         if lane:                     # the inverse system: x' = (A - b Cs/Ds) x + b a_s / Ds (no residual force)
             from .exact import steered_point
             b_x = bd_x[:, :n]
-            Js = np.zeros(n)
-            Js[0], Js[1] = 1.0, steered_point(self.vehicle)
-            Cs = np.einsum("k,bkj->bj", Js, A_x)
-            Cs[:, 1] += u
-            Ds = b_x @ Js
+            Cs, Ds = _steered_axle_rows(A_x, b_x, steered_point(self.vehicle), u)
             ctx = (A_x, bd_x, m, n, Cs, Ds)
         n_steps = int(round(t_end / dt))
         z_state = np.zeros((B, m))
@@ -490,11 +502,7 @@ class VariantBatch:
         AG = solve_scaled(M, np.concatenate([S, np.broadcast_to(np.eye(n), (rows.size, n, n))], axis=-1))
         A_x, Minv = AG[..., :n], AG[..., n:]
         b = np.einsum("bij,bj->bi", Minv, tire_scale * c["Bdelta"])
-        Js = np.zeros(n)
-        Js[0], Js[1] = 1.0, steered_point(self.vehicle)
-        Cs = np.einsum("k,bkj->bj", Js, A_x)
-        Cs[:, 1] += u
-        Ds = b @ Js
+        Cs, Ds = _steered_axle_rows(A_x, b, steered_point(self.vehicle), u)
         exists = np.abs(Ds) >= 1e-12 * np.maximum(1.0, np.abs(Cs).max(axis=1))
         out = np.zeros(rows.size, bool)
         if exists.any():
