@@ -194,9 +194,9 @@ class SchemeAssessment:
         vehicle, lcvreport's version, the files' SHA-256, every measure (value, lower bound,
         verdicts, resolved limits, margins, reason), the level the vehicle reaches and why not
         the first."""
-        from importlib.metadata import version
+        from ..version import __version__
         return {"scheme": self.scheme.name, "status": self.scheme.status, "levels": list(self.scheme.levels),
-                "vehicle": self.vehicle.name, "lcvreport_version": version("lcvreport"),
+                "vehicle": self.vehicle.name, "lcvreport_version": __version__,
                 "files": {k: dict(v) for k, v in self.files.items()}, "tire_scale": self.tire_scale,
                 "measures": [m.to_dict() for m in self.measures], "level_reached": self.level_reached,
                 "reason": self.reason}
