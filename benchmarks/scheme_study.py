@@ -51,6 +51,8 @@ def per_case(s, count: int) -> float:
 
 
 def main() -> None:
+    from machine import machine_line       # (benchmarks/machine.py: a time is read with its machine)
+    print(machine_line())
     v = load_vehicle(VEHICLE)
     names = [u.name for u in v.units]
     for f in list(FACTORS):

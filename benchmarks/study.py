@@ -452,6 +452,8 @@ def part2(rounds):
 
 
 def main() -> None:
+    from machine import machine_line       # (benchmarks/machine.py: a time is read with its machine)
+    print(machine_line())
     quick = "--quick" in sys.argv
     per = part1(500 if quick else 2000, 20 if quick else 60, 2 if quick else 3)
     v = load_preset("aucnat")
