@@ -2,6 +2,8 @@
 the one-variant calls on random batches to 1e-12 relative."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -279,6 +281,34 @@ def test_a_variants_batched_measures_do_not_depend_on_the_variants_beside_it(nam
         for key, column in full.items():
             if key != "case_id":
                 assert np.array_equal(part[key], np.asarray(column)[rows], equal_nan=True), (key, rows)
+
+
+def _cpu_flags() -> set:
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            return {w for line in f if line.startswith("flags") for w in line.split(":", 1)[1].split()}
+    except OSError:
+        return set()
+
+
+@pytest.mark.parametrize("core, flag", [("Nehalem", "sse4_2"), ("SandyBridge", "avx"), ("Haswell", "avx2")])
+def test_no_variant_depends_on_its_neighbours_with_other_blas_kernels(core, flag):
+    """The two tests above, bit for bit, with OpenBLAS's kernels of older processors
+    (``OPENBLAS_CORETYPE``): the machines CI may run on.  (Sandy Bridge's kernels rounded the
+    steady turn's sideslips by the batch's size until every batched product was taken row by row,
+    ``lcvreport.util.numerics.rowwise``.)"""
+    import os
+    import re
+    import subprocess
+    import sys
+    if flag not in _cpu_flags():
+        pytest.skip(f"this processor has no {flag}: OpenBLAS's {core} kernels cannot run here")
+    env = dict(os.environ, OPENBLAS_CORETYPE=core, OPENBLAS_NUM_THREADS="1")
+    p = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
+                        str(Path(__file__)), "-k", "do_not_depend_on_the_variants_beside_it"],
+                       capture_output=True, text=True, env=env, cwd=Path(__file__).parents[1], timeout=600)
+    assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-2000:]
+    assert re.search(r"\b4 passed\b", p.stdout), p.stdout[-1000:]
 
 
 def test_a_variant_with_an_unstable_inverse_system_has_no_lane_change():

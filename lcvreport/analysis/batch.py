@@ -35,7 +35,7 @@ import numpy as np
 
 from ..model.linear import linear_model, stiffness
 from ..model.vehicle import Vehicle
-from ..util.numerics import solve_scaled
+from ..util.numerics import rowwise, solve_scaled
 
 #: the coefficients the batch varies, and the parameters it can vary
 COEFFICIENTS = ("M0", "M1", "S0", "Sinv", "Su", "Skin", "Bdelta")
@@ -234,11 +234,9 @@ class VariantBatch:
         S = stiffness(c, u, tire_scale)
         b = tire_scale * c["Bdelta"]
         w = 2 * np.pi * float(f_hz)
-        x = np.linalg.solve(1j * w * M - S, b[..., None])            # (B, n, 1)
-        # products per variant (stacks of 1-row matrices): a (B, n) @ (n, N) product may round a
-        # variant by B (AVX-512 kernels), and a study's chunks would change its numbers
-        x = np.swapaxes(x, 1, 2)
-        return (x @ co.velocity_map(u).T * (1j * w) + u * (x @ co.yaw_rate_map().T))[:, 0]
+        x = np.linalg.solve(1j * w * M - S, b[..., None])[..., 0]
+        # products per variant: a study's chunks never change a variant's numbers
+        return rowwise(x, co.velocity_map(u).T) * (1j * w) + u * rowwise(x, co.yaw_rate_map().T)
 
     def rearward_amplification(self, speed_mps: float, f_hz: float, tire_scale: float = 1.0) -> np.ndarray:
         """RA(f) = |G_N| / |G_1| [-] of every variant, shape (B,)."""
@@ -258,7 +256,7 @@ class VariantBatch:
         (uq, xq), (up, xp) = reference_points(v)
         nu = v.n_units
         Theta = np.cumsum(x[:, nu + 1:], axis=1)
-        lateral = lambda unit, xx: Theta @ point_lateral_map(v, unit, xx)[2:]  # noqa: E731 (psi1 = Y1 = 0)
+        lateral = lambda unit, xx: rowwise(Theta, point_lateral_map(v, unit, xx)[2:])  # noqa: E731 (psi1 = Y1 = 0)
         dX = point_longitudinal(v, up, xp) - point_longitudinal(v, uq, xq)
         return delta, lateral(up, xp) - lateral(uq, xq) - dX * x[:, 0] / u
 
@@ -281,7 +279,7 @@ class VariantBatch:
         b = np.broadcast_to((tire_scale * c["Bdelta"])[:, None], f_hz.shape + c["Bdelta"].shape[-1:])
         w = (2 * np.pi * f_hz)[..., None, None]
         x = np.linalg.solve(1j * w * M - S, b[..., None])[..., 0]
-        G = np.abs(x @ co.velocity_map(u).T * (1j * w[..., 0]) + u * (x @ co.yaw_rate_map().T))
+        G = np.abs(rowwise(x, co.velocity_map(u).T) * (1j * w[..., 0]) + u * rowwise(x, co.yaw_rate_map().T))
         return G[..., -1] / G[..., 0]
 
     def ra_scan(self, speed_mps: float, f_hz: np.ndarray, tire_scale: float) -> np.ndarray:

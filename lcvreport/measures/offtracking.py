@@ -33,6 +33,7 @@ from ..model.linear import check_speed, check_tire_scale, linear_model
 from ..model.vehicle import Vehicle
 from ..model.yaw_plane.equations import system_coefficients
 from ..ranges import RANGES
+from ..util.numerics import rowwise
 from .registry import MeasureCase
 
 #: the lane change of HSTO: A0 [g], F [Hz], time after it [s]
@@ -307,7 +308,7 @@ def steady_turn_batched(batch: VariantBatch, speed_mps: float, tire_scale: float
     omega = u / R
     v = batch.vehicle
     x, delta = batch.steady(u, np.zeros(linear_model(v, batch.model).n_states), omega, tire_scale)
-    beta = x @ linear_model(v, batch.model).velocity_map(u).T / u      # (B, N) CG sideslips
+    beta = rowwise(x, linear_model(v, batch.model).velocity_map(u).T) / u      # (B, N) CG sideslips, per variant
     d = chain_on_circle(v, beta, R)                                     # (B, N) the chain on the circle
     steered = max(v.steered_axles, key=lambda a: a.x_m)
     rear = v.units[-1].rearmost_axle

@@ -77,6 +77,37 @@ def solve_scaled(M: np.ndarray, B: np.ndarray) -> np.ndarray:
     return X[..., 0] if vector else X
 
 
+def rowwise(X: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """``X @ M`` with every row of ``X`` (its last axis) multiplied on its own: a row's numbers
+    never depend on the rows beside it.
+
+    A (B, n) @ (n, k) product is one BLAS call, and BLAS may round a row by B (its blocking; a
+    matrix-vector product with fused multiply-adds where a dot product has none: seen with
+    OpenBLAS's AVX-512 and Sandy Bridge kernels), so a variant's numbers in a batch would depend on
+    how many variants share the call.  As a stack of one-row products they do not.
+
+    Parameters
+    ----------
+    X : numpy.ndarray, shape (..., n)
+    M : numpy.ndarray, shape (n, k) or (n,)
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (..., k), or (...) for a vector ``M``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> X, M = np.arange(6.0).reshape(3, 2), np.array([[1.0, 2.0], [3.0, 4.0]])
+    >>> np.array_equal(rowwise(X, M), X @ M), np.array_equal(rowwise(X[1:2], M), rowwise(X, M)[1:2])
+    (True, True)
+    """
+    X = np.asarray(X)
+    out = X[..., None, :] @ M
+    return out[..., 0] if np.ndim(M) == 1 else out[..., 0, :]
+
+
 def _onenorm(A: np.ndarray) -> float:
     return float(np.abs(A).sum(axis=0).max())
 
