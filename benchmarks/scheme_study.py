@@ -5,13 +5,17 @@ of 40 cases (``lcv study --scheme``: every case assessed), per case; the scheme 
 template scheme as shipped (40 and 128 cases: a block of turns side by side) and without its ``stfd`` entry (the nonlinear model's turn with tire
 forces); and ``assess`` of one new variant in process, without and with ``stfd``: new masses, new
 bodies (wider: the turns' run is shared, their swept paths new), a new geometry (a coupling moved).  One process, one BLAS thread, the study's
-own chunk function (no Dask start-up in the times).
+own chunk function (no Dask start-up in the times).  Last, ``lcv assess`` of the B-double as a
+command (11 runs, start-up and shutdown included), beside the floor no code of ours can move:
+a Python that imports numpy, scipy.linalg and scipy.integrate and exits.
 
     python benchmarks/scheme_study.py
 """
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")    # before numpy is imported
 
@@ -83,6 +87,26 @@ def main() -> None:
               f"{min(masses) * 1e3:.0f}, worst {max(masses) * 1e3:.0f} of 7); new bodies (body width) median "
               f"{np.median(widths) * 1e3:.0f} ms of 3; a new geometry (the first coupling moved) median "
               f"{np.median(hitches) * 1e3:.0f} ms of 3 (target <= 200 ms)")
+    lcv = [sys.executable, "-m", "lcvreport.cli", "assess", "--vehicle", str(VEHICLE),
+           "--scheme", str(ROOT / "examples" / "schemes" / "template.toml")]
+    floor = [sys.executable, "-c", "import numpy, scipy.linalg, scipy.integrate"]
+    for name, argv in (("lcv assess (B-double, template) as a command", lcv),
+                       ("the floor: python importing numpy, scipy.linalg, scipy.integrate", floor)):
+        times = command_times(argv, 11)
+        print(f"{name}: median {np.median(times) * 1e3:.0f} ms (best {min(times) * 1e3:.0f}, worst "
+              f"{max(times) * 1e3:.0f} of 11){' (target <= 500 ms)' if argv is lcv else ''}")
+
+
+def command_times(argv, runs: int) -> list:
+    """The wall time of each of ``runs`` runs of the command ``argv`` [s] (after one unmeasured
+    run: the files in the page cache)."""
+    subprocess.run(argv, check=True, capture_output=True, cwd=ROOT)
+    times = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        subprocess.run(argv, check=True, capture_output=True, cwd=ROOT)
+        times.append(time.perf_counter() - t0)
+    return times
 
 
 def mass_variant(v, factor: float):

@@ -19,6 +19,7 @@ Where things live (a folder is a layer; each imports only the ones above it)
     ``text``             what a user's text may hold (no control characters) and how a message quotes it
     ``compiled``         the package's C sources compiled on this machine, cached, loaded (ctypes)
     ``interrupts``       Ctrl-C and SIGTERM the interpreter swallowed still end a command as interrupted
+    ``startup``          a command's start-up and shutdown: numpy's unused subpackages lazy, no collection of the imports
 ``model/``               **what a vehicle is, and the models of it** (numpy only):
     ``vehicle``          Axle, Unit, Vehicle (SI parameter sets, validated)
     ``vehicle_file``     vehicle files (TOML, SI): load_vehicle, dumps_vehicle
